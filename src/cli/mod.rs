@@ -1,0 +1,8 @@
+//! One file per subcommand: `XArgs` (clap) and `run(XArgs) -> anyhow::Result<ExitCode>`.
+
+pub mod check;
+pub mod convert;
+pub mod eval;
+pub mod param;
+pub mod patches;
+pub mod remesh;

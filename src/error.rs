@@ -1,0 +1,36 @@
+//! The crate's error: one `thiserror` enum per stage, wrapped here. The binary adds
+//! context with `anyhow`; the library never does.
+
+use thiserror::Error;
+
+/// Any error of the conemesh library.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// Invalid mesh arrays.
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    /// Reading or writing a file.
+    #[error(transparent)]
+    Io(#[from] crate::io::IoError),
+    /// A certified invariant does not hold.
+    #[error(transparent)]
+    Invariant(#[from] crate::invariants::InvariantError),
+    /// Metric field (Sec. 3.1).
+    #[error(transparent)]
+    Metric(#[from] crate::metric::MetricError),
+    /// Patch generation (Sec. 3.2).
+    #[error(transparent)]
+    Patch(#[from] crate::patches::PatchError),
+    /// Parameterization (Sec. 3.3).
+    #[error(transparent)]
+    Param(#[from] crate::param::ParamError),
+    /// Planar remeshing (Sec. 3.3).
+    #[error(transparent)]
+    Remesh2d(#[from] crate::remesh2d::Remesh2dError),
+    /// Algorithm 1.
+    #[error(transparent)]
+    Pipeline(#[from] crate::pipeline::PipelineError),
+}
+
+/// Result with the crate's [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,107 @@
+//! Certified invariants (`certify_*`), checked after every stage in every run, cheap
+//! enough to leave on. Each returns the offending elements by id in its error.
+//!
+//! One file per family: `mesh.rs` (manifold, oriented, degenerate, self-intersections,
+//! topology and boundary kept, flips against a reference surface), `disk.rs` (patches),
+//! `bijective.rs` (parameterizations), `planar.rs` (2D remeshing).
+
+use crate::ids::{EdgeKey, FaceId, VertexId};
+use serde::Serialize;
+use std::fmt;
+use thiserror::Error;
+
+/// Elements named in an invariant failure; prints the first ten and the count of the rest.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Offenders<T>(pub Vec<T>);
+
+impl<T: fmt::Display> fmt::Display for Offenders<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, x) in self.0.iter().take(10).enumerate() {
+            if i > 0 {
+                write!(f, ", ")?;
+            }
+            write!(f, "{x}")?;
+        }
+        if self.0.len() > 10 {
+            write!(f, " … and {} more", self.0.len() - 10)?;
+        }
+        Ok(())
+    }
+}
+
+/// A pair of faces, printed `f3×f9`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+pub struct FacePair(pub FaceId, pub FaceId);
+
+impl fmt::Display for FacePair {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}×{}", self.0, self.1)
+    }
+}
+
+/// An edge with its face count, printed `(v3, v9) has 3 faces`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct EdgeFaces(pub EdgeKey, pub usize);
+
+impl fmt::Display for EdgeFaces {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} has {} faces", self.0, self.1)
+    }
+}
+
+/// The shared vocabulary of invariant failures (CGAL habit).
+#[derive(Debug, Error, Clone, PartialEq, Serialize)]
+pub enum InvariantError {
+    /// Edges with three or more faces.
+    #[error("non-manifold edges: {0}")]
+    NonManifoldEdges(Offenders<EdgeFaces>),
+    /// Vertices whose faces form more than one fan.
+    #[error("non-manifold vertices: {0}")]
+    NonManifoldVertices(Offenders<VertexId>),
+    /// Edges whose two faces traverse them in the same direction.
+    #[error("inconsistent orientation across edges: {0}")]
+    InconsistentOrientation(Offenders<EdgeKey>),
+    /// Faces of exactly zero area (collinear corners, exact test).
+    #[error("degenerate (zero-area) faces: {0}")]
+    DegenerateFaces(Offenders<FaceId>),
+    /// Pairs of faces that intersect other than in their shared elements.
+    #[error("self-intersecting face pairs: {0}")]
+    SelfIntersections(Offenders<FacePair>),
+    /// Genus, component count or boundary-loop count changed.
+    #[error("topology changed: {what} was {before}, is {after}")]
+    TopologyChanged {
+        /// which quantity
+        what: String,
+        /// before
+        before: String,
+        /// after
+        after: String,
+    },
+    /// Input boundary vertices that moved or vanished.
+    #[error("boundary vertices not preserved: {0}")]
+    BoundaryVerticesMoved(Offenders<VertexId>),
+    /// Input boundary edges that vanished.
+    #[error("boundary edges not preserved: {0}")]
+    BoundaryEdgesMissing(Offenders<EdgeKey>),
+    /// A patch that is not a topological disk.
+    #[error("patch is not a disk: {reason}")]
+    NotADisk {
+        /// what is wrong, naming the vertex, edge or count
+        reason: String,
+    },
+    /// A 2D map with non-positive triangles or a self-touching boundary.
+    #[error("map is not bijective: {reason}")]
+    NotBijective {
+        /// which triangles / boundary edges
+        reason: String,
+    },
+    /// Faces whose normal is more than 90° from the reference surface's normal.
+    #[error("flipped faces relative to the reference surface: {0}")]
+    FlippedFaces(Offenders<FaceId>),
+    /// A planar remeshing result that broke its contract (boundary, area, orientation).
+    #[error("planar mesh invalid: {reason}")]
+    PlanarInvalid {
+        /// what is wrong, naming the vertex or triangle
+        reason: String,
+    },
+}

@@ -1,0 +1,438 @@
+//! The triangle mesh: positions + triangles are the source of truth (parry habit); all
+//! topology ([`Topology`]) is derived from them and can be rebuilt at any time.
+
+pub mod generators;
+pub mod location;
+pub mod topology;
+
+pub use location::SurfaceLocation;
+pub use topology::{ComponentInfo, Topology};
+
+use crate::ids::{FaceId, VertexId};
+use nalgebra::{Point3, Vector3};
+use thiserror::Error;
+
+/// Errors raised when constructing a mesh from raw arrays.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum MeshError {
+    /// The mesh has no faces.
+    #[error("empty mesh: no triangles")]
+    Empty,
+    /// A coordinate is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate ({x}, {y}, {z})")]
+    NonFiniteCoordinate {
+        /// the vertex
+        vertex: VertexId,
+        /// x
+        x: f64,
+        /// y
+        y: f64,
+        /// z
+        z: f64,
+    },
+    /// A triangle references a vertex that does not exist.
+    #[error("face {face} references vertex index {index}, but the mesh has {n_vertices} vertices")]
+    IndexOutOfRange {
+        /// the face
+        face: FaceId,
+        /// the bad index
+        index: u64,
+        /// number of vertices
+        n_vertices: usize,
+    },
+    /// A triangle uses the same vertex twice.
+    #[error("face {face} repeats vertex {vertex}")]
+    RepeatedVertex {
+        /// the face
+        face: FaceId,
+        /// the repeated vertex
+        vertex: VertexId,
+    },
+    /// More elements than a `u32` id can name.
+    #[error("mesh too large: {what} count {count} exceeds u32 ids")]
+    TooLarge {
+        /// "vertex" or "face"
+        what: &'static str,
+        /// the count
+        count: usize,
+    },
+}
+
+/// An indexed triangle mesh. Triangles are oriented: `[a, b, c]` has the normal
+/// `(b − a) × (c − a)`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions (file units).
+    pub positions: Vec<Point3<f64>>,
+    /// Triangles as vertex ids, counter-clockwise seen from the outside.
+    pub triangles: Vec<[VertexId; 3]>,
+}
+
+impl TriMesh {
+    /// Build and validate a mesh: finite coordinates, in-range indices, no face repeating a
+    /// vertex, at least one face. Topological validity (manifoldness, orientation) is checked
+    /// separately by [`crate::invariants`], so that `check` can report on broken meshes.
+    pub fn new(
+        positions: Vec<Point3<f64>>,
+        triangles: Vec<[VertexId; 3]>,
+    ) -> Result<Self, MeshError> {
+        let m = TriMesh {
+            positions,
+            triangles,
+        };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Build a mesh from `usize` indices (validated like [`TriMesh::new`]).
+    pub fn from_indices(
+        positions: Vec<Point3<f64>>,
+        tris: &[[usize; 3]],
+    ) -> Result<Self, MeshError> {
+        if positions.len() > u32::MAX as usize {
+            return Err(MeshError::TooLarge {
+                what: "vertex",
+                count: positions.len(),
+            });
+        }
+        if tris.len() > u32::MAX as usize / 3 {
+            return Err(MeshError::TooLarge {
+                what: "face",
+                count: tris.len(),
+            });
+        }
+        let n = positions.len();
+        let mut triangles = Vec::with_capacity(tris.len());
+        for (fi, t) in tris.iter().enumerate() {
+            for &i in t {
+                if i >= n {
+                    return Err(MeshError::IndexOutOfRange {
+                        face: FaceId::new(fi),
+                        index: i as u64,
+                        n_vertices: n,
+                    });
+                }
+            }
+            triangles.push([
+                VertexId::new(t[0]),
+                VertexId::new(t[1]),
+                VertexId::new(t[2]),
+            ]);
+        }
+        TriMesh::new(positions, triangles)
+    }
+
+    /// Check the array-level rules of [`TriMesh::new`].
+    pub fn validate(&self) -> Result<(), MeshError> {
+        if self.positions.len() > u32::MAX as usize {
+            return Err(MeshError::TooLarge {
+                what: "vertex",
+                count: self.positions.len(),
+            });
+        }
+        if self.triangles.len() > u32::MAX as usize / 3 {
+            return Err(MeshError::TooLarge {
+                what: "face",
+                count: self.triangles.len(),
+            });
+        }
+        if self.triangles.is_empty() {
+            return Err(MeshError::Empty);
+        }
+        for (i, p) in self.positions.iter().enumerate() {
+            if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+                return Err(MeshError::NonFiniteCoordinate {
+                    vertex: VertexId::new(i),
+                    x: p.x,
+                    y: p.y,
+                    z: p.z,
+                });
+            }
+        }
+        let n = self.positions.len();
+        for (fi, t) in self.triangles.iter().enumerate() {
+            for v in t {
+                if v.idx() >= n {
+                    return Err(MeshError::IndexOutOfRange {
+                        face: FaceId::new(fi),
+                        index: v.0 as u64,
+                        n_vertices: n,
+                    });
+                }
+            }
+            if t[0] == t[1] || t[0] == t[2] {
+                return Err(MeshError::RepeatedVertex {
+                    face: FaceId::new(fi),
+                    vertex: t[0],
+                });
+            }
+            if t[1] == t[2] {
+                return Err(MeshError::RepeatedVertex {
+                    face: FaceId::new(fi),
+                    vertex: t[1],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of vertices (including unreferenced ones).
+    #[inline]
+    pub fn n_vertices(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of triangles.
+    #[inline]
+    pub fn n_faces(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Iterator over all face ids.
+    pub fn faces(&self) -> impl ExactSizeIterator<Item = FaceId> + '_ {
+        (0..self.triangles.len()).map(FaceId::new)
+    }
+
+    /// Iterator over all vertex ids.
+    pub fn vertices(&self) -> impl ExactSizeIterator<Item = VertexId> + '_ {
+        (0..self.positions.len()).map(VertexId::new)
+    }
+
+    /// Position of a vertex.
+    #[inline]
+    pub fn position(&self, v: VertexId) -> &Point3<f64> {
+        &self.positions[v.idx()]
+    }
+
+    /// The three vertex ids of a face.
+    #[inline]
+    pub fn face(&self, f: FaceId) -> [VertexId; 3] {
+        self.triangles[f.idx()]
+    }
+
+    /// The three corner positions of a face.
+    #[inline]
+    pub fn face_points(&self, f: FaceId) -> [Point3<f64>; 3] {
+        let t = self.triangles[f.idx()];
+        [
+            self.positions[t[0].idx()],
+            self.positions[t[1].idx()],
+            self.positions[t[2].idx()],
+        ]
+    }
+
+    /// Unnormalised face normal `(b − a) × (c − a)` (length = twice the area).
+    #[inline]
+    pub fn face_normal_raw(&self, f: FaceId) -> Vector3<f64> {
+        let [a, b, c] = self.face_points(f);
+        (b - a).cross(&(c - a))
+    }
+
+    /// Unit face normal; the zero vector for a face of zero area.
+    pub fn face_normal(&self, f: FaceId) -> Vector3<f64> {
+        let n = self.face_normal_raw(f);
+        let l = n.norm();
+        if l > 0.0 {
+            n / l
+        } else {
+            Vector3::zeros()
+        }
+    }
+
+    /// Face area.
+    #[inline]
+    pub fn face_area(&self, f: FaceId) -> f64 {
+        0.5 * self.face_normal_raw(f).norm()
+    }
+
+    /// Face centroid.
+    pub fn face_centroid(&self, f: FaceId) -> Point3<f64> {
+        let [a, b, c] = self.face_points(f);
+        Point3::from((a.coords + b.coords + c.coords) / 3.0)
+    }
+
+    /// Total surface area.
+    pub fn area(&self) -> f64 {
+        self.faces().map(|f| self.face_area(f)).sum()
+    }
+
+    /// Axis-aligned bounding box `(min, max)` of the referenced and unreferenced vertices.
+    /// Returns `None` for a mesh with no vertices.
+    pub fn bbox(&self) -> Option<(Point3<f64>, Point3<f64>)> {
+        let first = *self.positions.first()?;
+        let (mut lo, mut hi) = (first, first);
+        for p in &self.positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        Some((lo, hi))
+    }
+
+    /// Length of the bounding-box diagonal (0 for an empty mesh).
+    pub fn bbox_diagonal(&self) -> f64 {
+        self.bbox().map(|(lo, hi)| (hi - lo).norm()).unwrap_or(0.0)
+    }
+
+    /// Vertex normals: area-weighted (unnormalised face normals summed), normalised.
+    pub fn vertex_normals(&self) -> Vec<Vector3<f64>> {
+        let mut n = vec![Vector3::zeros(); self.n_vertices()];
+        for f in self.faces() {
+            let fnrm = self.face_normal_raw(f);
+            for v in self.face(f) {
+                n[v.idx()] += fnrm;
+            }
+        }
+        for x in &mut n {
+            let l = x.norm();
+            if l > 0.0 {
+                *x /= l;
+            }
+        }
+        n
+    }
+
+    /// Mean edge length over all half-edges (each interior edge counted twice).
+    pub fn mean_edge_length(&self) -> f64 {
+        let mut s = 0.0;
+        for f in self.faces() {
+            let [a, b, c] = self.face_points(f);
+            s += (b - a).norm() + (c - b).norm() + (a - c).norm();
+        }
+        s / (3 * self.n_faces()).max(1) as f64
+    }
+
+    /// The mesh with every face's orientation reversed.
+    pub fn flipped(&self) -> TriMesh {
+        TriMesh {
+            positions: self.positions.clone(),
+            triangles: self.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect(),
+        }
+    }
+
+    /// A copy without vertices that no triangle references, and the map old → new id.
+    pub fn without_unreferenced_vertices(&self) -> (TriMesh, Vec<Option<VertexId>>) {
+        let mut map = vec![None; self.n_vertices()];
+        let mut positions = Vec::new();
+        let mut triangles = Vec::with_capacity(self.n_faces());
+        for t in &self.triangles {
+            let mut nt = [VertexId(0); 3];
+            for (k, v) in t.iter().enumerate() {
+                let id = *map[v.idx()].get_or_insert_with(|| {
+                    positions.push(self.positions[v.idx()]);
+                    VertexId::new(positions.len() - 1)
+                });
+                nt[k] = id;
+            }
+            triangles.push(nt);
+        }
+        (
+            TriMesh {
+                positions,
+                triangles,
+            },
+            map,
+        )
+    }
+
+    /// Indices of vertices referenced by no triangle.
+    pub fn unreferenced_vertices(&self) -> Vec<VertexId> {
+        let mut used = vec![false; self.n_vertices()];
+        for t in &self.triangles {
+            for v in t {
+                used[v.idx()] = true;
+            }
+        }
+        used.iter()
+            .enumerate()
+            .filter(|(_, u)| !**u)
+            .map(|(i, _)| VertexId::new(i))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> TriMesh {
+        TriMesh::from_indices(
+            vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(0.0, 1.0, 0.0),
+            ],
+            &[[0, 1, 2]],
+        )
+        .expect("valid triangle")
+    }
+
+    #[test]
+    fn area_normal_and_bbox_of_unit_right_triangle() {
+        let m = tri();
+        assert_eq!(m.face_area(FaceId(0)), 0.5);
+        assert_eq!(m.face_normal(FaceId(0)), Vector3::new(0.0, 0.0, 1.0));
+        assert_eq!(
+            m.flipped().face_normal(FaceId(0)),
+            Vector3::new(0.0, 0.0, -1.0)
+        );
+        assert!((m.bbox_diagonal() - 2f64.sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn constructor_rejects_bad_arrays_by_element() {
+        let p = vec![
+            Point3::origin(),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, f64::NAN, 0.0),
+        ];
+        let e = TriMesh::from_indices(p.clone(), &[[0, 1, 2]]).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                MeshError::NonFiniteCoordinate {
+                    vertex: VertexId(2),
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        let e = TriMesh::from_indices(p.clone(), &[[0, 1, 5]]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "face f0 references vertex index 5, but the mesh has 3 vertices"
+        );
+        let mut ok = p;
+        ok[2].y = 1.0;
+        let e = TriMesh::from_indices(ok.clone(), &[[0, 1, 1]]).unwrap_err();
+        assert!(matches!(
+            e,
+            MeshError::RepeatedVertex {
+                face: FaceId(0),
+                vertex: VertexId(1)
+            }
+        ));
+        assert_eq!(
+            TriMesh::from_indices(ok, &[]).unwrap_err(),
+            MeshError::Empty
+        );
+    }
+
+    #[test]
+    fn unreferenced_vertices_are_dropped_and_mapped() {
+        let mut m = tri();
+        m.positions.insert(0, Point3::new(5.0, 5.0, 5.0));
+        for t in &mut m.triangles {
+            for v in t.iter_mut() {
+                v.0 += 1;
+            }
+        }
+        assert_eq!(m.unreferenced_vertices(), vec![VertexId(0)]);
+        let (c, map) = m.without_unreferenced_vertices();
+        assert_eq!(c.n_vertices(), 3);
+        assert_eq!(map[0], None);
+        assert_eq!(map[1], Some(VertexId(0)));
+        assert_eq!(c.face_area(FaceId(0)), 0.5);
+    }
+}

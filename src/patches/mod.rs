@@ -1,0 +1,86 @@
+//! Patch generation (Sec. 3.2): cone patches and the [`PatchStrategy`] extension point.
+//!
+//! Files: `cone_fit.rs` (Eq. 1-2), `growth_cost.rs` (Eq. 3), `grow.rs` (greedy growth with
+//! the exact disk rule), `expand.rs` (1-2 ring expansion), `cone.rs` (the paper's strategy).
+
+use crate::ids::{EdgeKey, FaceId, PatchId, VertexId};
+use crate::mesh::{Topology, TriMesh};
+use nalgebra::Vector3;
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+use std::collections::HashSet;
+use thiserror::Error;
+
+/// Errors of patch generation.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum PatchError {
+    /// The mesh handed to the strategy is not usable (non-manifold, …).
+    #[error("patch generation: {0}")]
+    InvalidMesh(String),
+    /// A produced patch failed its certificate.
+    #[error("patch {patch} (seed {seed}): {source}")]
+    NotCertified {
+        /// the patch
+        patch: PatchId,
+        /// its seed vertex
+        seed: VertexId,
+        /// the violated invariant
+        source: crate::invariants::InvariantError,
+    },
+}
+
+/// A fitted cone (Eq. 1-2): unit axis `n_P` and angle `α_P` between axis and face normals.
+#[derive(Copy, Clone, Debug, PartialEq, Serialize)]
+pub struct Cone {
+    /// Unit axis n_P.
+    pub axis: Vector3<f64>,
+    /// Angle α_P in radians.
+    pub angle: f64,
+}
+
+/// A patch: faces of the working mesh forming a topological disk.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Patch {
+    /// Faces, sorted by id.
+    pub faces: Vec<FaceId>,
+    /// The boundary as an ordered vertex loop, oriented so that the patch lies to its left
+    /// (it follows the patch faces' half-edge direction).
+    pub boundary: Vec<VertexId>,
+    /// The seed vertex the patch was started from.
+    pub seed_vertex: VertexId,
+    /// The seed triangle s_P.
+    pub seed_face: FaceId,
+    /// The fitted cone, for strategies that fit one.
+    pub cone: Option<Cone>,
+}
+
+/// What a strategy sees: the working mesh, its topology, which faces are processed, and
+/// optionally edges no patch may cross (feature lines).
+#[derive(Clone, Copy)]
+pub struct PatchContext<'a> {
+    /// The working mesh.
+    pub mesh: &'a TriMesh,
+    /// Its topology (built from `mesh`).
+    pub topology: &'a Topology,
+    /// `processed[f]` for every face of `mesh`.
+    pub processed: &'a [bool],
+    /// Edges patches must not cross (their interior may not contain them).
+    pub feature_edges: Option<&'a HashSet<EdgeKey>>,
+}
+
+/// The research extension point of Sec. 3.2: produce the next patch to remesh.
+///
+/// Contract: a returned patch is a topological disk (certified by the caller with
+/// `invariants::certify_disk`) containing at least one unprocessed face, does not cross
+/// feature edges, and its boundary loop is oriented as documented on [`Patch`]. `Ok(None)`
+/// means there is no unprocessed face left.
+pub trait PatchStrategy: Send + Sync {
+    /// Short name (`cone`, …) used in reports and on the command line.
+    fn name(&self) -> &'static str;
+    /// The next patch, drawing randomness only from `rng`.
+    fn next_patch(
+        &self,
+        ctx: &PatchContext<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Option<Patch>, PatchError>;
+}

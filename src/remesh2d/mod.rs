@@ -1,0 +1,72 @@
+//! Planar anisotropic remeshing (Sec. 3.3): metric transfer (Eq. 4), the LCT remesher
+//! (ref. [5]) and the [`PlanarRemesher`] extension point.
+
+use nalgebra::{Matrix2, Point2};
+use rand_chacha::ChaCha8Rng;
+use thiserror::Error;
+
+/// Errors of planar remeshing.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum Remesh2dError {
+    /// The input domain is invalid (not a positively oriented disk triangulation, …).
+    #[error("invalid planar domain: {0}")]
+    InvalidDomain(String),
+    /// A metric value is not symmetric positive definite.
+    #[error("metric not SPD at ({x}, {y})")]
+    MetricNotSpd {
+        /// x
+        x: f64,
+        /// y
+        y: f64,
+    },
+    /// The output failed its certificate.
+    #[error(transparent)]
+    Invariant(#[from] crate::invariants::InvariantError),
+}
+
+/// A metric field on the plane: an SPD 2×2 tensor at every point of the domain.
+pub trait Metric2d: Sync {
+    /// The metric at `p`.
+    fn metric(&self, p: &Point2<f64>) -> Matrix2<f64>;
+}
+
+/// The input of a planar remesher: a positively oriented triangulation of a simple polygon.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanarDomain {
+    /// Vertex positions.
+    pub points: Vec<Point2<f64>>,
+    /// Counter-clockwise triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// The boundary loop (counter-clockwise); these vertices and the edges between
+    /// consecutive ones are kept exactly.
+    pub boundary: Vec<u32>,
+    /// Interior edges that must also be kept (mesh boundary or feature lines).
+    pub constrained_edges: Vec<[u32; 2]>,
+}
+
+/// The output of a planar remesher.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanarMesh {
+    /// Vertex positions.
+    pub points: Vec<Point2<f64>>,
+    /// Counter-clockwise triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// For each output vertex, the input vertex it is (bit-identical position), if any.
+    /// Every boundary and constrained vertex of the input appears here.
+    pub origin: Vec<Option<u32>>,
+}
+
+/// The research extension point: remesh a planar domain to follow a metric, keeping the
+/// boundary loop and constrained edges exactly.
+pub trait PlanarRemesher: Send + Sync {
+    /// Short name used in reports.
+    fn name(&self) -> &'static str;
+    /// Remesh `domain` so that edges have metric length close to `target_length`.
+    fn remesh(
+        &self,
+        domain: &PlanarDomain,
+        metric: &dyn Metric2d,
+        target_length: f64,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<PlanarMesh, Remesh2dError>;
+}
