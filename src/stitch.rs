@@ -1,1 +1,237 @@
-//! (in progress)
+//! Replacing a remeshed patch inside the working mesh (Algorithm 1, step e).
+//!
+//! The working mesh of Algorithm 1 is a [`WorkingMesh`]: the triangle mesh being rebuilt,
+//! for every vertex its location on the reference surface, and for every face whether it is
+//! processed. [`stitch`] swaps a patch's faces for the remeshed triangles. It touches only
+//! the arrays (no global topology rebuild inside); vertices that no face references any more
+//! stay in the arrays until [`WorkingMesh::compact`] at the end, so ids of untouched
+//! elements are stable while the loop runs.
+
+use crate::ids::{FaceId, VertexId};
+use crate::mesh::{SurfaceLocation, TriMesh};
+use nalgebra::Point3;
+use thiserror::Error;
+
+/// Errors of patch replacement.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum StitchError {
+    /// A face id out of range or listed twice.
+    #[error("patch face {0} is out of range or repeated")]
+    BadFace(FaceId),
+    /// A replacement triangle refers to a vertex that does not exist.
+    #[error("replacement triangle {triangle} refers to missing vertex {vertex}")]
+    BadVertex {
+        /// index in the replacement list
+        triangle: usize,
+        /// the vertex reference
+        vertex: String,
+    },
+}
+
+/// The state of Algorithm 1: the mesh being remeshed, where each of its vertices lies on the
+/// reference surface, and which faces are processed.
+#[derive(Clone, Debug)]
+pub struct WorkingMesh {
+    /// The current mesh (unit-diagonal space).
+    pub mesh: TriMesh,
+    /// `locations[v]`: where vertex `v` lies on the reference mesh.
+    pub locations: Vec<SurfaceLocation>,
+    /// `processed[f]`: face `f` was produced by (or lies inside) an already remeshed patch.
+    pub processed: Vec<bool>,
+}
+
+/// A vertex of a replacement triangle: an existing working-mesh vertex (patch boundary) or
+/// the index of a new vertex in [`Replacement::new_positions`].
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum PatchVertex {
+    /// A vertex already in the working mesh.
+    Existing(VertexId),
+    /// A new vertex.
+    New(u32),
+}
+
+/// The remeshed patch, ready to be stitched.
+#[derive(Clone, Debug, Default)]
+pub struct Replacement {
+    /// Positions of the new vertices.
+    pub new_positions: Vec<Point3<f64>>,
+    /// Their locations on the reference surface (parallel to `new_positions`).
+    pub new_locations: Vec<SurfaceLocation>,
+    /// The triangles, counter-clockwise seen from outside.
+    pub triangles: Vec<[PatchVertex; 3]>,
+}
+
+impl WorkingMesh {
+    /// Start Algorithm 1 on `reference`: every vertex located at itself, nothing processed.
+    pub fn from_reference(reference: &TriMesh) -> WorkingMesh {
+        let mut locations = vec![
+            SurfaceLocation {
+                face: FaceId(0),
+                bary: [1.0, 0.0, 0.0]
+            };
+            reference.n_vertices()
+        ];
+        // Each vertex is located as a corner of its last incident face.
+        for (f, t) in reference.triangles.iter().enumerate() {
+            for (k, v) in t.iter().enumerate() {
+                let mut bary = [0.0; 3];
+                bary[k] = 1.0;
+                locations[v.idx()] = SurfaceLocation {
+                    face: FaceId::new(f),
+                    bary,
+                };
+            }
+        }
+        WorkingMesh {
+            mesh: reference.clone(),
+            locations,
+            processed: vec![false; reference.n_faces()],
+        }
+    }
+
+    /// Number of unprocessed faces.
+    pub fn unprocessed(&self) -> usize {
+        self.processed.iter().filter(|p| !**p).count()
+    }
+
+    /// Drop vertices no face references; returns the old → new vertex map.
+    pub fn compact(&mut self) -> Vec<Option<VertexId>> {
+        let (mesh, map) = self.mesh.without_unreferenced_vertices();
+        let mut locations = vec![
+            SurfaceLocation {
+                face: FaceId(0),
+                bary: [1.0, 0.0, 0.0]
+            };
+            mesh.n_vertices()
+        ];
+        for (old, new) in map.iter().enumerate() {
+            if let Some(n) = new {
+                locations[n.idx()] = self.locations[old];
+            }
+        }
+        self.mesh = mesh;
+        self.locations = locations;
+        map
+    }
+}
+
+/// Replace the faces `patch_faces` of the working mesh by `replacement`, marking the new
+/// faces processed. Faces outside the patch keep their relative order (their ids shift
+/// down past removed faces); new faces are appended. Returns the ids of the new faces.
+pub fn stitch(
+    work: &mut WorkingMesh,
+    patch_faces: &[FaceId],
+    replacement: &Replacement,
+) -> Result<Vec<FaceId>, StitchError> {
+    let nf = work.mesh.n_faces();
+    let mut remove = vec![false; nf];
+    for &f in patch_faces {
+        if f.idx() >= nf || remove[f.idx()] {
+            return Err(StitchError::BadFace(f));
+        }
+        remove[f.idx()] = true;
+    }
+    let base = work.mesh.n_vertices() as u32;
+    let nv_new = replacement.new_positions.len() as u32;
+    let mut tris = Vec::with_capacity(replacement.triangles.len());
+    for (i, t) in replacement.triangles.iter().enumerate() {
+        let mut out = [VertexId(0); 3];
+        for (k, pv) in t.iter().enumerate() {
+            out[k] = match *pv {
+                PatchVertex::Existing(v) if v.idx() < work.mesh.n_vertices() => v,
+                PatchVertex::New(j) if j < nv_new => VertexId(base + j),
+                other => {
+                    return Err(StitchError::BadVertex {
+                        triangle: i,
+                        vertex: format!("{other:?}"),
+                    })
+                }
+            };
+        }
+        tris.push(out);
+    }
+    let mut triangles = Vec::with_capacity(nf - patch_faces.len() + tris.len());
+    let mut processed = Vec::with_capacity(triangles.capacity());
+    for f in 0..nf {
+        if !remove[f] {
+            triangles.push(work.mesh.triangles[f]);
+            processed.push(work.processed[f]);
+        }
+    }
+    let first_new = triangles.len();
+    triangles.extend_from_slice(&tris);
+    processed.resize(triangles.len(), true);
+    work.mesh.triangles = triangles;
+    work.mesh
+        .positions
+        .extend_from_slice(&replacement.new_positions);
+    work.locations.extend_from_slice(&replacement.new_locations);
+    work.processed = processed;
+    Ok((first_new..work.mesh.n_faces()).map(FaceId::new).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{generators, Topology};
+
+    #[test]
+    fn stitch_replaces_fan_by_split_fan_and_keeps_manifold() {
+        // Replace the centre fan of a disk by the same fan around a new, moved centre vertex.
+        let d = generators::disk(1.0, 2, 6);
+        let mut w = WorkingMesh::from_reference(&d);
+        let topo = Topology::build(&d);
+        let fan: Vec<FaceId> = topo.vertex_faces(VertexId(0)).to_vec();
+        let ring: Vec<VertexId> = (1..=6).map(VertexId).collect();
+        let repl = Replacement {
+            new_positions: vec![Point3::new(0.01, 0.0, 0.0)],
+            new_locations: vec![w.locations[0]],
+            triangles: (0..6)
+                .map(|i| {
+                    [
+                        PatchVertex::New(0),
+                        PatchVertex::Existing(ring[i]),
+                        PatchVertex::Existing(ring[(i + 1) % 6]),
+                    ]
+                })
+                .collect(),
+        };
+        let before_unprocessed = w.unprocessed();
+        let new_faces = stitch(&mut w, &fan, &repl).expect("valid replacement");
+        assert_eq!(new_faces.len(), 6);
+        assert_eq!(w.unprocessed(), before_unprocessed - 6);
+        assert!(new_faces.iter().all(|f| w.processed[f.idx()]));
+        let t = Topology::build(&w.mesh);
+        assert!(t.is_oriented_manifold());
+        assert_eq!(t.components()[0].euler, 1);
+        assert_eq!(t.boundary_loops().len(), 1);
+        // Old centre is now unreferenced and disappears on compaction.
+        let map = w.compact();
+        assert_eq!(map[0], None);
+        assert_eq!(w.mesh.n_vertices(), d.n_vertices());
+        assert_eq!(w.locations.len(), w.mesh.n_vertices());
+    }
+
+    #[test]
+    fn stitch_rejects_bad_references() {
+        let d = generators::disk(1.0, 1, 6);
+        let mut w = WorkingMesh::from_reference(&d);
+        let bad = Replacement {
+            triangles: vec![[
+                PatchVertex::New(0),
+                PatchVertex::Existing(VertexId(1)),
+                PatchVertex::Existing(VertexId(2)),
+            ]],
+            ..Default::default()
+        };
+        assert!(matches!(
+            stitch(&mut w, &[FaceId(0)], &bad),
+            Err(StitchError::BadVertex { triangle: 0, .. })
+        ));
+        assert_eq!(
+            stitch(&mut w, &[FaceId(0), FaceId(0)], &Replacement::default()),
+            Err(StitchError::BadFace(FaceId(0)))
+        );
+        assert_eq!(w.mesh, d, "a refused stitch leaves the mesh untouched");
+    }
+}
