@@ -32,15 +32,22 @@ pub(crate) struct Tokens<'a> {
     line: usize,
     /// Line of the last token returned (or of the end of the file).
     pub(crate) last_line: usize,
+    first: usize,
 }
 
 impl<'a> Tokens<'a> {
     pub(crate) fn new(text: &'a str) -> Self {
+        Self::starting_at(text, 1)
+    }
+
+    /// Tokens of `text` whose first line is line `first` of the file.
+    pub(crate) fn starting_at(text: &'a str, first: usize) -> Self {
         Tokens {
             lines: text.lines().enumerate(),
             cur: "".split_ascii_whitespace(),
-            line: 0,
-            last_line: 0,
+            line: first.saturating_sub(1),
+            last_line: first.saturating_sub(1),
+            first,
         }
     }
 }
@@ -54,7 +61,7 @@ impl<'a> Iterator for Tokens<'a> {
                 return Some((self.line, t));
             }
             let (i, l) = self.lines.next()?;
-            self.line = i + 1;
+            self.line = i + self.first;
             self.last_line = self.line;
             let l = l.split('#').next().unwrap_or("");
             self.cur = l.split_ascii_whitespace();
