@@ -63,7 +63,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         return Err(IoError::BadMagic {
             path: path.to_string(),
             format: F,
-            found: short(first),
+            found: super::printable(first.as_bytes()),
         });
     }
     let _version = match t.next() {

@@ -256,7 +256,7 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
         return Err(IoError::BadMagic {
             path: path.to_string(),
             format: F,
-            found: short(&String::from_utf8_lossy(&bytes[..first_end.min(24)])),
+            found: super::printable(&bytes[..first_end]),
         });
     }
     // The header ends at the line `end_header`; the body starts after its newline.
