@@ -30,16 +30,19 @@ fn rng(seed: u64) -> conemesh::Rng {
     conemesh::Rng::seed_from_u64(seed)
 }
 
-/// Shortest edge length of the mesh.
-fn min_edge(m: &TriMesh) -> f64 {
+/// Smallest triangle altitude of the mesh (twice the area over the longest edge).
+fn min_altitude(m: &TriMesh) -> f64 {
     m.faces()
-        .flat_map(|f| {
+        .map(|f| {
             let p = m.face_points(f);
-            [
+            let longest = [
                 (p[1] - p[0]).norm(),
                 (p[2] - p[1]).norm(),
                 (p[0] - p[2]).norm(),
             ]
+            .into_iter()
+            .fold(0.0, f64::max);
+            2.0 * m.face_area(f) / longest
         })
         .fold(f64::INFINITY, f64::min)
 }
