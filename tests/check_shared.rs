@@ -114,3 +114,41 @@ fn shared_meshes_validity() {
         }
     }
 }
+
+fn run_cli(args: &[&str]) -> (Option<i32>, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_conemesh"))
+        .arg("check")
+        .args(args)
+        .output()
+        .expect("the conemesh binary runs");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+    )
+}
+
+/// Exit codes: 0 valid (built-in torus), 1 invalid (cow.off self-intersects), 2 unreadable.
+#[test]
+fn cli_exit_codes_and_json() {
+    let (code, out) = run_cli(&[]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(
+        out.contains("genus 1") && out.trim_end().ends_with("valid: yes"),
+        "{out}"
+    );
+    let cow = format!("{MESHES}/cow.off");
+    let (code, out) = run_cli(&["--json", &cow]);
+    assert_eq!(code, Some(1), "{out}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("--json prints JSON");
+    assert_eq!(v["valid"], serde_json::Value::Bool(false));
+    assert_eq!(v["self_intersections"]["pairs"], serde_json::json!(118));
+    // Without the self-intersection search the cow is valid.
+    let (code, out) = run_cli(&["--no-self-intersections", &cow]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(
+        out.contains("self-intersecting face pairs: not checked"),
+        "{out}"
+    );
+    let (code, _) = run_cli(&["/nonexistent/mesh.off"]);
+    assert_eq!(code, Some(2));
+}
