@@ -3,6 +3,8 @@
 //!
 //! The API below is the contract other modules build on; the format files implement it.
 
+pub mod sol;
+
 use crate::mesh::TriMesh;
 use nalgebra::Point2;
 use std::path::Path;
