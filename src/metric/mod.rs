@@ -1,6 +1,23 @@
 //! The Riemannian metric field (Sec. 3.1, Sec. 4.1): curvature metric per reference vertex,
 //! evaluated anywhere on the reference surface by closest point + barycentric interpolation.
+//!
+//! - [`normalize`]: the unit-diagonal normalization the pipeline works in.
+//! - [`curvature`]: principal curvatures and directions by a local quadric fit.
+//! - [`curvature_metric`]: `M = (d₁,d₂,n) diag(max(|k₁|,10⁻⁴), max(|k₂|,10⁻⁴), 0) (d₁,d₂,n)ᵀ`.
+//! - [`field`]: [`MetricField`], the one way later stages ask for the metric.
+//!
+//! User-supplied metrics come from Medit `.sol` files ([`crate::io::sol`]).
 
+pub mod curvature;
+pub mod field;
+pub mod normalize;
+
+pub use curvature::{principal_curvatures, tangent_frame, CurvatureOptions, PrincipalCurvature};
+pub use field::{validate_vertex_metric, MetricField};
+pub use normalize::Normalization;
+
+use crate::mesh::{MeshError, TriMesh};
+use nalgebra::Matrix3;
 use thiserror::Error;
 
 /// Errors of the metric stage.
@@ -14,4 +31,74 @@ pub enum MetricError {
         /// eigenvalues or other detail
         detail: String,
     },
+    /// A tensor has a NaN or infinite entry.
+    #[error("metric at vertex v{vertex} has a NaN or infinite entry")]
+    NonFinite {
+        /// vertex index
+        vertex: usize,
+    },
+    /// The number of tensors differs from the number of reference vertices.
+    #[error("metric has {found} tensors but the reference mesh has {expected} vertices")]
+    CountMismatch {
+        /// number of reference vertices
+        expected: usize,
+        /// number of tensors given
+        found: usize,
+    },
+    /// The reference mesh is invalid (empty, non-finite coordinates, bad indices).
+    #[error("reference mesh: {0}")]
+    Mesh(#[from] MeshError),
+    /// The closest-point structure could not be built.
+    #[error("closest-point BVH: {detail}")]
+    Bvh {
+        /// parry's message
+        detail: String,
+    },
+}
+
+/// Options of the curvature metric (Sec. 4.1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MetricOptions {
+    /// Curvature estimation (quadric fit radius).
+    pub curvature: CurvatureOptions,
+    /// Lower bound on |k₁|, |k₂| (default `1e-4`, the paper's value, "to prevent the long
+    /// edge length caused by too small curvature"); in unit-space units (1/bbox diagonal).
+    pub floor: f64,
+}
+
+impl Default for MetricOptions {
+    fn default() -> Self {
+        MetricOptions {
+            curvature: CurvatureOptions::default(),
+            floor: 1e-4,
+        }
+    }
+}
+
+/// The curvature metric of one vertex (Sec. 4.1):
+/// `M = (d₁, d₂, d₁×d₂) diag(max(|k₁|, floor), max(|k₂|, floor), 0) (d₁, d₂, d₁×d₂)ᵀ`.
+/// Rank 2: zero along the normal, at least `floor` on the tangent plane.
+pub fn metric_from_curvature(pc: &PrincipalCurvature, floor: f64) -> Matrix3<f64> {
+    let l1 = pc.k1.abs().max(floor);
+    let l2 = pc.k2.abs().max(floor);
+    let m = pc.d1 * pc.d1.transpose() * l1 + pc.d2 * pc.d2.transpose() * l2;
+    // Exactly symmetric, whatever the rounding of the outer products.
+    (m + m.transpose()) * 0.5
+}
+
+/// The curvature metric (Sec. 4.1) at every vertex of `mesh`, from
+/// [`principal_curvatures`] and [`metric_from_curvature`].
+///
+/// Expects the **unit-space** mesh (bounding-box diagonal 1, see [`Normalization`]): the floor
+/// is in 1/(unit length). Convert the result to file units with
+/// [`Normalization::metric_from_unit`] if needed.
+pub fn curvature_metric(
+    mesh: &TriMesh,
+    opts: &MetricOptions,
+) -> Result<Vec<Matrix3<f64>>, MetricError> {
+    let pcs = principal_curvatures(mesh, &opts.curvature)?;
+    Ok(pcs
+        .iter()
+        .map(|pc| metric_from_curvature(pc, opts.floor))
+        .collect())
 }
