@@ -9,8 +9,10 @@
 //! the input's bounding-box diagonal 1); angles in degrees; percentages in 0..=100.
 
 mod distance;
+mod eval;
 
 pub use distance::{approximation_error, flips, Distance, SurfaceProjector};
+pub use eval::{evaluate, EvalOptions, EvalReport, EvalTimings, MeshSize, TargetLength};
 
 use crate::ids::{EdgeKey, VertexId};
 use crate::mesh::TriMesh;
