@@ -11,6 +11,7 @@ mod medit;
 mod obj;
 mod off;
 mod ply;
+pub mod sol;
 mod stl;
 mod text;
 

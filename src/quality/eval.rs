@@ -7,13 +7,13 @@
 //! closest point on the input (barycentric interpolation, Sec. 4.1).
 
 use super::{
-    approximation_error, edge_conformity, edge_length_average, flips, quality_stats,
-    Conformity, Distance, QualityStats,
+    approximation_error, edge_conformity, edge_length_average, flips, quality_stats, Conformity,
+    Distance, QualityStats,
 };
 use crate::ids::FaceId;
 use crate::invariants::{certify_same_topology, self_intersections};
-use crate::metric::{MetricField, MetricOptions, Normalization};
 use crate::mesh::TriMesh;
+use crate::metric::{MetricField, MetricOptions, Normalization};
 use nalgebra::Matrix3;
 use rand::SeedableRng;
 use serde::Serialize;
@@ -163,7 +163,11 @@ pub fn evaluate(
     let in_metrics = field.vertex_metrics();
     let out_metrics: Vec<Matrix3<f64>> = {
         use rayon::prelude::*;
-        unit_out.positions.par_iter().map(|p| field.eval(p)).collect()
+        unit_out
+            .positions
+            .par_iter()
+            .map(|p| field.eval(p))
+            .collect()
     };
     let l_avg = edge_length_average(&unit_in, in_metrics);
     let l_tar = match opts.target {

@@ -1,0 +1,500 @@
+//! Medit `.sol` files (the Gamma Mesh Format used by Medit and MMG): per-vertex metric tensors.
+//!
+//! Conventions (see `paper-notes.md` § 3.1):
+//! - Only `SolAtVertices` with exactly one solution field, dimension 3.
+//! - Type 3 (symmetric matrix): six numbers per vertex in the order `m11 m12 m22 m13 m23 m33`
+//!   (the lower triangle row by row, the order MMG reads).
+//! - Type 1 (scalar): an isotropic target size `h` (MMG's convention), read as the metric
+//!   `M = I / h²` (so that an edge of length `h` has metric length 1); `h` must be positive.
+//! - ASCII and binary (`libMeshb` layout: a 4-byte `1` giving the byte order, the version, then
+//!   keywords `code, next-keyword position, header, data`). Versions 1 (float32), 2 (float64,
+//!   32-bit positions) and 3 (float64, 64-bit positions) are read; binary files are written as
+//!   version 2 little-endian (version 3 above 2 GiB), ASCII files with the shortest decimal that
+//!   reads back to the same `f64` (bit-exact round trip).
+//!
+//! The reader checks the format only (count, finiteness, layout); positive definiteness on the
+//! tangent plane is checked against the mesh by [`crate::metric::MetricField::new`].
+
+use nalgebra::Matrix3;
+use std::io::Write;
+use std::path::Path;
+use thiserror::Error;
+
+/// Errors of reading and writing `.sol` files.
+#[derive(Debug, Error)]
+pub enum SolError {
+    /// Operating-system error on a path.
+    #[error("{path}: {source}")]
+    Io {
+        /// the file
+        path: String,
+        /// the OS error
+        source: std::io::Error,
+    },
+    /// The file has a different number of vertices than the mesh.
+    #[error("{path}: SolAtVertices has {found} entries but the mesh has {expected} vertices")]
+    CountMismatch {
+        /// the file
+        path: String,
+        /// vertices of the mesh
+        expected: usize,
+        /// entries in the file
+        found: usize,
+    },
+    /// A value is NaN or infinite.
+    #[error("{path}: the solution at vertex v{vertex} is NaN or infinite")]
+    NaN {
+        /// the file
+        path: String,
+        /// 0-based vertex index
+        vertex: usize,
+    },
+    /// A scalar size that is not positive.
+    #[error("{path}: the size at vertex v{vertex} is {value}, not positive")]
+    InvalidSize {
+        /// the file
+        path: String,
+        /// 0-based vertex index
+        vertex: usize,
+        /// the value read
+        value: f64,
+    },
+    /// A token that does not parse, or a misplaced keyword.
+    #[error("{path}:{line}: {detail}")]
+    Parse {
+        /// the file
+        path: String,
+        /// 1-based line number (ASCII) or 0 (binary)
+        line: usize,
+        /// what went wrong
+        detail: String,
+    },
+    /// Dimension, solution type, field count or binary version we do not read.
+    #[error("{path}: unsupported: {detail}")]
+    UnsupportedType {
+        /// the file
+        path: String,
+        /// what
+        detail: String,
+    },
+    /// The file ends before all the data announced by its header.
+    #[error("{path}: truncated: {detail}")]
+    Truncated {
+        /// the file
+        path: String,
+        /// what was missing
+        detail: String,
+    },
+}
+
+const KW_DIMENSION: i32 = 3;
+const KW_END: i32 = 54;
+const KW_SOL_AT_VERTICES: i32 = 62;
+const TYPE_SCALAR: i64 = 1;
+const TYPE_SYM_MATRIX: i64 = 3;
+
+/// The raw content of the `SolAtVertices` block.
+struct RawSol {
+    count: usize,
+    kind: i64,
+    values: Vec<f64>,
+}
+
+fn values_per_vertex(kind: i64) -> usize {
+    if kind == TYPE_SCALAR {
+        1
+    } else {
+        6
+    }
+}
+
+/// Read a `.sol` file of metric tensors for a mesh with `n_vertices` vertices (see the module
+/// doc for the conventions). One symmetric tensor per vertex, in vertex order.
+pub fn read_sol(path: &Path, n_vertices: usize) -> Result<Vec<Matrix3<f64>>, SolError> {
+    let p = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| SolError::Io {
+        path: p.clone(),
+        source,
+    })?;
+    let raw = if bytes.len() >= 4 && (bytes[..4] == [1, 0, 0, 0] || bytes[..4] == [0, 0, 0, 1]) {
+        read_binary(&p, &bytes, n_vertices)?
+    } else {
+        read_ascii(&p, &bytes, n_vertices)?
+    };
+    let per = values_per_vertex(raw.kind);
+    let mut out = Vec::with_capacity(raw.count);
+    for v in 0..raw.count {
+        let x = &raw.values[v * per..(v + 1) * per];
+        if !x.iter().all(|y| y.is_finite()) {
+            return Err(SolError::NaN { path: p, vertex: v });
+        }
+        if raw.kind == TYPE_SCALAR {
+            let h = x[0];
+            if !(h > 0.0) {
+                return Err(SolError::InvalidSize {
+                    path: p,
+                    vertex: v,
+                    value: h,
+                });
+            }
+            out.push(Matrix3::identity() / (h * h));
+        } else {
+            let (m11, m12, m22, m13, m23, m33) = (x[0], x[1], x[2], x[3], x[4], x[5]);
+            out.push(Matrix3::new(m11, m12, m13, m12, m22, m23, m13, m23, m33));
+        }
+    }
+    Ok(out)
+}
+
+fn check_header(
+    p: &str,
+    line: usize,
+    dim: i64,
+    count: usize,
+    types: &[i64],
+    n_vertices: usize,
+) -> Result<i64, SolError> {
+    if dim != 3 {
+        return Err(SolError::UnsupportedType {
+            path: p.to_string(),
+            detail: format!("dimension {dim} (only 3)"),
+        });
+    }
+    if types.len() != 1 || !(types[0] == TYPE_SCALAR || types[0] == TYPE_SYM_MATRIX) {
+        return Err(SolError::UnsupportedType {
+            path: p.to_string(),
+            detail: format!(
+                "solution types {types:?} at line {line} (only one field of type 1 or 3)"
+            ),
+        });
+    }
+    if count != n_vertices {
+        return Err(SolError::CountMismatch {
+            path: p.to_string(),
+            expected: n_vertices,
+            found: count,
+        });
+    }
+    Ok(types[0])
+}
+
+fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| SolError::Parse {
+        path: p.to_string(),
+        line: 0,
+        detail: format!("neither binary nor UTF-8 text ({e})"),
+    })?;
+    // Tokens with their 1-based line; '#' starts a comment.
+    let mut tokens = text.lines().enumerate().flat_map(|(i, l)| {
+        let l = l.split('#').next().unwrap_or("");
+        l.split_whitespace().map(move |t| (i + 1, t))
+    });
+    let mut last_line = 1usize;
+    let parse_err = |line: usize, detail: String| SolError::Parse {
+        path: p.to_string(),
+        line,
+        detail,
+    };
+    let mut dim = 3i64;
+    let mut sol: Option<RawSol> = None;
+    macro_rules! next_int {
+        ($what:expr) => {{
+            match tokens.next() {
+                None => {
+                    return Err(SolError::Truncated {
+                        path: p.to_string(),
+                        detail: format!("end of file where {} was expected", $what),
+                    })
+                }
+                Some((line, t)) => {
+                    last_line = line;
+                    t.parse::<i64>().map_err(|_| {
+                        parse_err(
+                            line,
+                            format!("expected {} (an integer), found {t:?}", $what),
+                        )
+                    })?
+                }
+            }
+        }};
+    }
+    while let Some((line, tok)) = tokens.next() {
+        last_line = line;
+        if tok.eq_ignore_ascii_case("MeshVersionFormatted") {
+            let _version = next_int!("the version");
+        } else if tok.eq_ignore_ascii_case("Dimension") {
+            dim = next_int!("the dimension");
+        } else if tok.eq_ignore_ascii_case("SolAtVertices") {
+            if sol.is_some() {
+                return Err(parse_err(line, "second SolAtVertices block".into()));
+            }
+            let count = next_int!("the number of vertices");
+            if count < 0 {
+                return Err(parse_err(last_line, format!("negative count {count}")));
+            }
+            let ntypes = next_int!("the number of solution fields");
+            if !(0..=64).contains(&ntypes) {
+                return Err(parse_err(last_line, format!("{ntypes} solution fields")));
+            }
+            let mut types = Vec::new();
+            for _ in 0..ntypes {
+                types.push(next_int!("a solution type"));
+            }
+            let kind = check_header(p, line, dim, count as usize, &types, n_vertices)?;
+            let need = count as usize * values_per_vertex(kind);
+            let mut values = Vec::with_capacity(need);
+            for k in 0..need {
+                let Some((l, t)) = tokens.next() else {
+                    return Err(SolError::Truncated {
+                        path: p.to_string(),
+                        detail: format!(
+                            "{need} values announced, {k} found (vertex v{} incomplete)",
+                            k / values_per_vertex(kind)
+                        ),
+                    });
+                };
+                last_line = l;
+                let x = t
+                    .parse::<f64>()
+                    .map_err(|_| parse_err(l, format!("expected a number, found {t:?}")))?;
+                values.push(x);
+            }
+            sol = Some(RawSol {
+                count: count as usize,
+                kind,
+                values,
+            });
+        } else if tok.eq_ignore_ascii_case("End") {
+            break;
+        } else {
+            return Err(parse_err(
+                line,
+                format!("unexpected token {tok:?} (expected a keyword: MeshVersionFormatted, Dimension, SolAtVertices, End)"),
+            ));
+        }
+    }
+    sol.ok_or_else(|| SolError::Truncated {
+        path: p.to_string(),
+        detail: format!("no SolAtVertices block (read up to line {last_line})"),
+    })
+}
+
+/// A bounds-checked reader of binary words in the file's byte order.
+struct Cursor<'a> {
+    p: &'a str,
+    bytes: &'a [u8],
+    pos: usize,
+    big_endian: bool,
+}
+
+impl Cursor<'_> {
+    fn take<const N: usize>(&mut self, what: &str) -> Result<[u8; N], SolError> {
+        let end = self.pos.checked_add(N).filter(|e| *e <= self.bytes.len());
+        let Some(end) = end else {
+            return Err(SolError::Truncated {
+                path: self.p.to_string(),
+                detail: format!("end of file at byte {} reading {what}", self.pos),
+            });
+        };
+        let mut b = [0u8; N];
+        b.copy_from_slice(&self.bytes[self.pos..end]);
+        self.pos = end;
+        if self.big_endian {
+            b.reverse();
+        }
+        Ok(b)
+    }
+    fn i32(&mut self, what: &str) -> Result<i64, SolError> {
+        Ok(i32::from_le_bytes(self.take::<4>(what)?) as i64)
+    }
+    fn i64(&mut self, what: &str) -> Result<i64, SolError> {
+        Ok(i64::from_le_bytes(self.take::<8>(what)?))
+    }
+    fn f32(&mut self, what: &str) -> Result<f64, SolError> {
+        Ok(f32::from_le_bytes(self.take::<4>(what)?) as f64)
+    }
+    fn f64(&mut self, what: &str) -> Result<f64, SolError> {
+        Ok(f64::from_le_bytes(self.take::<8>(what)?))
+    }
+}
+
+fn read_binary(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolError> {
+    let mut c = Cursor {
+        p,
+        bytes,
+        pos: 0,
+        big_endian: bytes[..4] == [0, 0, 0, 1],
+    };
+    let _code = c.i32("the byte-order code")?;
+    let version = c.i32("the version")?;
+    if !(1..=3).contains(&version) {
+        return Err(SolError::UnsupportedType {
+            path: p.to_string(),
+            detail: format!("binary version {version} (1, 2 or 3)"),
+        });
+    }
+    let mut dim = 3i64;
+    loop {
+        let kw = c.i32("a keyword")? as i32;
+        let next = if version >= 3 {
+            c.i64("a keyword position")?
+        } else {
+            c.i32("a keyword position")?
+        };
+        match kw {
+            KW_END => break,
+            KW_DIMENSION => dim = c.i32("the dimension")?,
+            KW_SOL_AT_VERTICES => {
+                let count = c.i32("the number of vertices")?;
+                let ntypes = c.i32("the number of solution fields")?;
+                if count < 0 || !(0..=64).contains(&ntypes) {
+                    return Err(SolError::Parse {
+                        path: p.to_string(),
+                        line: 0,
+                        detail: format!(
+                            "SolAtVertices header at byte {}: count {count}, {ntypes} fields",
+                            c.pos
+                        ),
+                    });
+                }
+                let mut types = Vec::new();
+                for _ in 0..ntypes {
+                    types.push(c.i32("a solution type")?);
+                }
+                let kind = check_header(p, 0, dim, count as usize, &types, n_vertices)?;
+                let need = count as usize * values_per_vertex(kind);
+                let width = if version == 1 { 4 } else { 8 };
+                if bytes.len() - c.pos < need * width {
+                    return Err(SolError::Truncated {
+                        path: p.to_string(),
+                        detail: format!(
+                            "{need} values announced, {} bytes left for them",
+                            bytes.len() - c.pos
+                        ),
+                    });
+                }
+                let mut values = Vec::with_capacity(need);
+                for _ in 0..need {
+                    values.push(if version == 1 {
+                        c.f32("a value")?
+                    } else {
+                        c.f64("a value")?
+                    });
+                }
+                return Ok(RawSol {
+                    count: count as usize,
+                    kind,
+                    values,
+                });
+            }
+            _ => {
+                // Unknown keyword: jump over it with its next-keyword position.
+                if next <= 0 || next as usize > bytes.len() || next as usize <= c.pos {
+                    break;
+                }
+                c.pos = next as usize;
+            }
+        }
+    }
+    Err(SolError::Truncated {
+        path: p.to_string(),
+        detail: "no SolAtVertices block".into(),
+    })
+}
+
+/// The six stored numbers `m11 m12 m22 m13 m23 m33` of a tensor (its upper triangle).
+fn six(m: &Matrix3<f64>) -> [f64; 6] {
+    [
+        m[(0, 0)],
+        m[(0, 1)],
+        m[(1, 1)],
+        m[(0, 2)],
+        m[(1, 2)],
+        m[(2, 2)],
+    ]
+}
+
+/// Write one symmetric tensor per vertex as a type-3 `.sol` file, ASCII or binary, atomically
+/// (a temporary file in the same directory, renamed over `path`). Only the upper triangle is
+/// stored; a non-finite entry is [`SolError::NaN`] and nothing is written.
+pub fn write_sol(path: &Path, metrics: &[Matrix3<f64>], binary: bool) -> Result<(), SolError> {
+    let p = path.display().to_string();
+    for (v, m) in metrics.iter().enumerate() {
+        if !six(m).iter().all(|x| x.is_finite()) {
+            return Err(SolError::NaN { path: p, vertex: v });
+        }
+    }
+    let bytes = if binary {
+        binary_bytes(metrics)
+    } else {
+        ascii_bytes(metrics)
+    };
+    let io = |source: std::io::Error| SolError::Io {
+        path: p.clone(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(&dir).map_err(io)?;
+    tmp.write_all(&bytes).map_err(io)?;
+    tmp.as_file().sync_all().map_err(io)?;
+    tmp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
+}
+
+fn ascii_bytes(metrics: &[Matrix3<f64>]) -> Vec<u8> {
+    use std::fmt::Write as _;
+    let mut s = String::with_capacity(64 + metrics.len() * 120);
+    s.push_str("MeshVersionFormatted 2\n\nDimension 3\n\nSolAtVertices\n");
+    let _ = writeln!(s, "{}\n1 3", metrics.len());
+    for m in metrics {
+        let x = six(m);
+        // `{:e}` prints the shortest decimal that reads back to the same f64.
+        let _ = writeln!(
+            s,
+            "{:e} {:e} {:e} {:e} {:e} {:e}",
+            x[0], x[1], x[2], x[3], x[4], x[5]
+        );
+    }
+    s.push_str("\nEnd\n");
+    s.into_bytes()
+}
+
+fn binary_bytes(metrics: &[Matrix3<f64>]) -> Vec<u8> {
+    let data = metrics.len() * 48;
+    // Version 2 has 32-bit keyword positions; switch to version 3 when they would overflow.
+    let version: i32 = if data + 64 < i32::MAX as usize { 2 } else { 3 };
+    let mut b: Vec<u8> = Vec::with_capacity(data + 64);
+    let put_pos = |b: &mut Vec<u8>, pos: usize| {
+        if version == 2 {
+            b.extend_from_slice(&(pos as i32).to_le_bytes());
+        } else {
+            b.extend_from_slice(&(pos as i64).to_le_bytes());
+        }
+    };
+    let pos_width = if version == 2 { 4 } else { 8 };
+    b.extend_from_slice(&1i32.to_le_bytes());
+    b.extend_from_slice(&version.to_le_bytes());
+    // Dimension: code, next position, 3.
+    b.extend_from_slice(&KW_DIMENSION.to_le_bytes());
+    let next = b.len() + pos_width + 4;
+    put_pos(&mut b, next);
+    b.extend_from_slice(&3i32.to_le_bytes());
+    // SolAtVertices: code, next position, count, 1 field, type 3, data.
+    b.extend_from_slice(&KW_SOL_AT_VERTICES.to_le_bytes());
+    let next = b.len() + pos_width + 12 + data;
+    put_pos(&mut b, next);
+    b.extend_from_slice(&(metrics.len() as i32).to_le_bytes());
+    b.extend_from_slice(&1i32.to_le_bytes());
+    b.extend_from_slice(&(TYPE_SYM_MATRIX as i32).to_le_bytes());
+    for m in metrics {
+        for x in six(m) {
+            b.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    b.extend_from_slice(&KW_END.to_le_bytes());
+    put_pos(&mut b, 0);
+    b
+}
