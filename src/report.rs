@@ -259,10 +259,12 @@ pub fn write_quality_plots_with(
             ),
             x_desc: "smallest angle in the metric (degrees)",
             y_desc: "% of triangles",
-            x_max: 180.0,
+            // A triangle's smallest angle is at most 60° (an equilateral one counts in the
+            // [60°, 70°) bin): only the first seven bins can be non-empty.
+            x_max: 70.0,
             series: series
                 .iter()
-                .map(|(l, s)| (*l, s.hist_min_angles.to_vec()))
+                .map(|(l, s)| (*l, s.hist_min_angles[..7].to_vec()))
                 .collect(),
         },
     ];
