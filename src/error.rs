@@ -30,6 +30,9 @@ pub enum Error {
     /// Algorithm 1.
     #[error(transparent)]
     Pipeline(#[from] crate::pipeline::PipelineError),
+    /// Writing reports and plots.
+    #[error(transparent)]
+    Report(#[from] crate::report::ReportError),
 }
 
 /// Result with the crate's [`Error`].

@@ -1,12 +1,150 @@
-//! `conemesh eval` (in progress).
+//! `conemesh eval`: score a remeshed surface against its input (Sec. 4.1, Table 1). Parses,
+//! calls [`conemesh::quality::evaluate`], prints one Table-1 line, writes JSON and plots.
 
+use anyhow::Context;
+use conemesh::quality::{evaluate, EvalOptions, TargetLength};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Arguments of `conemesh eval`.
 #[derive(clap::Args, Debug)]
-pub struct EvalArgs {}
+pub struct EvalArgs {
+    /// The input (reference) surface; its bounding-box diagonal is the unit of every measure.
+    #[arg(long)]
+    pub input: PathBuf,
+    /// The surface to score (e.g. a remeshed input; the input itself gives its own quality).
+    #[arg(long)]
+    pub output: PathBuf,
+    /// L_tar = F · L_avg, L_avg the mean metric edge length of the input [default: 1.5].
+    #[arg(long, value_name = "F", conflicts_with = "ltar")]
+    pub ltar_factor: Option<f64>,
+    /// Absolute target edge length L_tar (metric length, input file units).
+    #[arg(long, value_name = "L")]
+    pub ltar: Option<f64>,
+    /// Per-input-vertex metric tensors (Medit .sol, file units) instead of the curvature metric.
+    #[arg(long, value_name = "M.sol")]
+    pub metric: Option<PathBuf>,
+    /// Write the full report as JSON.
+    #[arg(long, value_name = "R.json")]
+    pub json: Option<PathBuf>,
+    /// Write PNG histograms of q, all angles and smallest angles into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
+    /// Random samples per surface for Hausdorff / RMS (on top of all vertices).
+    #[arg(long, default_value_t = 100_000)]
+    pub samples: usize,
+    /// Seed of the sampling.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Skip the (exact) self-intersection search.
+    #[arg(long)]
+    pub no_self_intersections: bool,
+    /// Name in the first column [default: the output's file stem].
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Print only the row, without the header line.
+    #[arg(long)]
+    pub no_header: bool,
+}
 
 /// Run `conemesh eval`.
-pub fn run(_args: EvalArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`conemesh eval` is not available in this build yet")
+pub fn run(args: EvalArgs) -> anyhow::Result<ExitCode> {
+    let t0 = std::time::Instant::now();
+    let input = conemesh::io::read_mesh(&args.input)
+        .with_context(|| format!("reading input {}", args.input.display()))?
+        .mesh;
+    let output = conemesh::io::read_mesh(&args.output)
+        .with_context(|| format!("reading output {}", args.output.display()))?
+        .mesh;
+    let metric = match &args.metric {
+        Some(p) => Some(
+            conemesh::io::sol::read_sol(p, input.n_vertices())
+                .with_context(|| format!("reading metric {}", p.display()))?,
+        ),
+        None => None,
+    };
+    let target = match (args.ltar, args.ltar_factor) {
+        (Some(l), _) => {
+            anyhow::ensure!(l > 0.0 && l.is_finite(), "--ltar must be positive, got {l}");
+            TargetLength::Absolute(l)
+        }
+        (None, f) => {
+            let f = f.unwrap_or(1.5);
+            anyhow::ensure!(
+                f > 0.0 && f.is_finite(),
+                "--ltar-factor must be positive, got {f}"
+            );
+            TargetLength::Factor(f)
+        }
+    };
+    let opts = EvalOptions {
+        target,
+        samples: args.samples,
+        seed: args.seed,
+        self_intersections: !args.no_self_intersections,
+        ..EvalOptions::default()
+    };
+    let report = evaluate(&input, &output, metric.as_deref(), &opts)
+        .with_context(|| format!("evaluating {}", args.output.display()))?;
+    let name = args.name.clone().unwrap_or_else(|| {
+        args.output
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    });
+    if !args.no_header {
+        println!("{}", conemesh::quality::EvalReport::table_header());
+    }
+    println!("{}", report.table_row(&name));
+
+    let mut plot_files = Vec::new();
+    if let Some(dir) = &args.plots {
+        let same = args.input == args.output;
+        let series: Vec<(&str, &conemesh::quality::QualityStats)> = if same {
+            vec![("input", &report.input_quality)]
+        } else {
+            vec![
+                ("input", &report.input_quality),
+                ("output", &report.output_quality),
+            ]
+        };
+        plot_files = conemesh::report::write_quality_plots(dir, &name, &series)
+            .with_context(|| format!("writing plots to {}", dir.display()))?;
+    }
+    if let Some(path) = &args.json {
+        let doc = serde_json::json!({
+            "name": name,
+            "input_file": args.input.display().to_string(),
+            "output_file": args.output.display().to_string(),
+            "metric_file": args.metric.as_ref().map(|p| p.display().to_string()),
+            "samples": args.samples,
+            "seed": args.seed,
+            "plots": plot_files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+            "wall_seconds": t0.elapsed().as_secs_f64(),
+            "report": report,
+        });
+        write_atomic(path, serde_json::to_string_pretty(&doc)?.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    eprintln!(
+        "L_avg {:.6}, L_tar {:.6} (unit space, diagonal 1); metric: {}; {:.2} s",
+        report.l_avg,
+        report.l_tar,
+        report.metric_source,
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Write a file through a temporary file in the same folder, so a failure leaves no partial file.
+fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
+    use std::io::Write;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.persist(path)?;
+    Ok(())
 }

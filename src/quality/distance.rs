@@ -1,0 +1,187 @@
+//! Approximation error (two-sided sampled Hausdorff / RMS) and flips against the input.
+//! Closest points come from parry's BVH over the triangles and its point-triangle
+//! projection (exact Euclidean distance to the triangle, not to its vertices).
+
+use crate::ids::FaceId;
+use crate::mesh::TriMesh;
+use nalgebra::{Point3, Vector3};
+use parry3d_f64::math::Vector as PVec;
+use parry3d_f64::query::PointQueryWithLocation;
+use parry3d_f64::shape::TriMesh as PTriMesh;
+use rand::Rng as _;
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// Closest-point queries on a triangle mesh (parry BVH + point-triangle projection).
+pub struct SurfaceProjector {
+    bvh: Option<PTriMesh>,
+}
+
+impl SurfaceProjector {
+    /// Index the triangles of `mesh`. A mesh without faces gives a projector that finds
+    /// nothing.
+    pub fn new(mesh: &TriMesh) -> Self {
+        let vertices: Vec<PVec> = mesh
+            .positions
+            .iter()
+            .map(|p| PVec::new(p.x, p.y, p.z))
+            .collect();
+        let indices: Vec<[u32; 3]> = mesh
+            .triangles
+            .iter()
+            .map(|t| [t[0].0, t[1].0, t[2].0])
+            .collect();
+        let bvh = if indices.is_empty() {
+            None
+        } else {
+            PTriMesh::new(vertices, indices).ok()
+        };
+        SurfaceProjector { bvh }
+    }
+
+    /// The closest point of the surface to `p`, the face it lies on, and the distance.
+    /// `None` for an empty surface or a non-finite `p`.
+    pub fn closest(&self, p: &Point3<f64>) -> Option<(FaceId, Point3<f64>, f64)> {
+        let bvh = self.bvh.as_ref()?;
+        if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+            return None;
+        }
+        let q = PVec::new(p.x, p.y, p.z);
+        let (proj, (tri, _loc)) =
+            bvh.project_local_point_and_get_location_with_max_dist(q, false, f64::MAX)?;
+        let c = Point3::new(proj.point.x, proj.point.y, proj.point.z);
+        Some((FaceId(tri), c, (c - p).norm()))
+    }
+}
+
+/// Two-sided approximation error between two surfaces.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Distance {
+    /// Sampled Hausdorff distance max(d(a→b), d(b→a)), in mesh units.
+    pub hausdorff: f64,
+    /// Root mean square distance over the area-weighted samples of both sides (the mean of
+    /// the two one-sided mean squares, then the root), mesh units.
+    pub rms: f64,
+    /// `hausdorff` / bbox diagonal of `a`.
+    pub hausdorff_rel: f64,
+    /// `rms` / bbox diagonal of `a`.
+    pub rms_rel: f64,
+    /// One-sided max distance from samples of `a` to surface `b`.
+    pub hausdorff_a_to_b: f64,
+    /// One-sided max distance from samples of `b` to surface `a`.
+    pub hausdorff_b_to_a: f64,
+    /// Total number of sample points measured (both sides).
+    pub samples: usize,
+}
+
+/// Vertices of `m` plus `n_random` area-weighted uniform random points on its triangles.
+/// Returns (points, number of random points among them, which come last).
+fn sample_surface(m: &TriMesh, n_random: usize, rng: &mut crate::Rng) -> (Vec<Point3<f64>>, usize) {
+    let mut pts: Vec<Point3<f64>> = m.positions.clone();
+    // Cumulative area, for choosing a face with probability proportional to its area.
+    let mut cdf = Vec::with_capacity(m.n_faces());
+    let mut acc = 0.0;
+    for f in m.faces() {
+        acc += m.face_area(f);
+        cdf.push(acc);
+    }
+    if !(acc > 0.0 && acc.is_finite()) {
+        return (pts, 0);
+    }
+    pts.reserve(n_random);
+    for _ in 0..n_random {
+        let u: f64 = rng.random::<f64>() * acc;
+        let fi = cdf.partition_point(|&c| c <= u).min(cdf.len() - 1);
+        // Uniform point in a triangle: (1-√r1, √r1(1-r2), √r1·r2).
+        let (r1, r2): (f64, f64) = (rng.random(), rng.random());
+        let s = r1.sqrt();
+        let [a, b, c] = m.face_points(FaceId::new(fi));
+        let w = [1.0 - s, s * (1.0 - r2), s * r2];
+        pts.push(Point3::from(
+            a.coords * w[0] + b.coords * w[1] + c.coords * w[2],
+        ));
+    }
+    (pts, n_random)
+}
+
+/// (max distance over all samples, mean squared distance over the random samples) from the
+/// points to the surface.
+fn one_side(pts: &[Point3<f64>], n_random: usize, target: &SurfaceProjector) -> (f64, f64) {
+    let d: Vec<f64> = pts
+        .par_iter()
+        .map(|p| target.closest(p).map_or(f64::INFINITY, |(_, _, d)| d))
+        .collect();
+    let max = d.iter().copied().fold(0.0, f64::max);
+    // The RMS uses only the area-weighted random samples, so that it estimates the surface
+    // integral (vertex samples are denser where triangles are small and would bias it).
+    let tail = &d[d.len() - n_random..];
+    let ms = if tail.is_empty() {
+        d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64
+    } else {
+        tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64
+    };
+    (max, ms)
+}
+
+/// Two-sided sampled approximation error between surfaces `a` (the input) and `b`.
+///
+/// Each surface is sampled at all its vertices plus `min_samples` area-weighted random
+/// points (seeded by `rng`; first `a`'s, then `b`'s), and every sample is measured to the
+/// other surface by the exact point-triangle distance (parry BVH). Hausdorff is the larger
+/// of the two one-sided maxima; RMS is over the random samples of both sides; relative
+/// values divide by the bounding-box diagonal of `a`. The distance queries run in parallel
+/// and do not consume randomness, so the result depends only on the seed.
+pub fn approximation_error(
+    a: &TriMesh,
+    b: &TriMesh,
+    min_samples: usize,
+    rng: &mut crate::Rng,
+) -> Distance {
+    let (pa, na) = sample_surface(a, min_samples, rng);
+    let (pb, nb) = sample_surface(b, min_samples, rng);
+    let (ha, msa) = one_side(&pa, na, &SurfaceProjector::new(b));
+    let (hb, msb) = one_side(&pb, nb, &SurfaceProjector::new(a));
+    let hausdorff = ha.max(hb);
+    let rms = (0.5 * (msa + msb)).sqrt();
+    let diag = a.bbox_diagonal();
+    let rel = |x: f64| if diag > 0.0 { x / diag } else { f64::NAN };
+    Distance {
+        hausdorff,
+        rms,
+        hausdorff_rel: rel(hausdorff),
+        rms_rel: rel(rms),
+        hausdorff_a_to_b: ha,
+        hausdorff_b_to_a: hb,
+        samples: pa.len() + pb.len(),
+    }
+}
+
+/// Output faces whose normal points more than 90° away from the normal of the input face
+/// closest to the output face's centroid (the flip measure of the quality issue).
+///
+/// The decision is the sign of the float dot product of the two (unnormalised) face
+/// normals, strictly negative = flipped: a float decision on normals, not an exact
+/// predicate. It is only wrong for faces within rounding of 90° from the input, which are
+/// reported as not flipped; zero-area faces (zero normal) are never reported here (the
+/// degenerate-face certificate catches them). Where the centroid is equidistant from several
+/// input faces (a sharp edge), the one parry's BVH returns first is used.
+pub fn flips(input: &TriMesh, output: &TriMesh) -> Vec<FaceId> {
+    let proj = SurfaceProjector::new(input);
+    let flagged: Vec<bool> = (0..output.n_faces())
+        .into_par_iter()
+        .map(|i| {
+            let f = FaceId::new(i);
+            let n_out: Vector3<f64> = output.face_normal_raw(f);
+            match proj.closest(&output.face_centroid(f)) {
+                Some((fin, _, _)) => n_out.dot(&input.face_normal_raw(fin)) < 0.0,
+                None => false,
+            }
+        })
+        .collect();
+    flagged
+        .iter()
+        .enumerate()
+        .filter(|(_, &b)| b)
+        .map(|(i, _)| FaceId::new(i))
+        .collect()
+}
