@@ -9,17 +9,23 @@
 //! its JSON compared field by field with conemesh's own verdicts on the same triangles. A
 //! disagreement lists the case and every differing field.
 //!
-//! Semantic differences (also in TESTING.md):
-//! - CGAL reports a degenerate (exactly collinear) face `f` as the pair `(f, f)` and does not
-//!   test it against other faces. We compare CGAL's `(f, f)` pairs with conemesh's degenerate
-//!   faces, and CGAL's other pairs with conemesh's pairs between non-degenerate faces.
+//! Conventions (also in TESTING.md):
+//! - Both sides use CGAL's self-intersection semantics: a degenerate (exactly collinear) face
+//!   `f` is reported as the pair `(f, f)` and is not tested against other faces; faces sharing
+//!   an edge intersect only when coplanar and folded onto each other; faces sharing a vertex
+//!   only when an opposite edge meets the other face; touching counts. Pairs are compared as
+//!   sorted lists of `(f, g)`, `f <= g`, in the file's face order.
 //! - For soups that are not polygon meshes (non-manifold, inconsistently oriented), CGAL 5.5
 //!   cannot build a `Surface_mesh`: `closed` and `boundary_cycles` are `null` there and only the
-//!   counts, components and Euler characteristic are compared.
+//!   counts, components, Euler characteristic, degenerate faces and self-intersections (the
+//!   checker's replica of CGAL's pair test, itself validated against
+//!   `PMP::self_intersections` on every valid mesh) are compared.
+//! - conemesh's "valid" (manifold, consistently oriented, no self-intersection, no
+//!   degenerate face) is compared with CGAL's `valid_polygon_mesh && !self_intersects`.
 
 use conemesh::mesh::generators;
 use conemesh::predicates::{orient2d, segments_intersect, SegmentIntersection, Sign};
-use conemesh::{FaceId, Topology, TriMesh, VertexId};
+use conemesh::{invariants, io, FaceId, Topology, TriMesh, VertexId};
 use nalgebra::{Point2, Point3, Vector3};
 use rand::SeedableRng;
 use serde_json::Value;
@@ -132,94 +138,21 @@ fn run_checker(mesh: &Path, extra: &[&str]) -> Value {
 }
 
 // ---------------------------------------------------------------------------------------
-// Minimal OFF writer / OFF+OBJ reader (test-local until crate::io lands on main).
+// Files: conemesh's own reader and writer (so the witness sees exactly the bytes conemesh
+// writes; OFF text stores f64 exactly).
 
 fn write_off(path: &Path, m: &TriMesh) {
-    let mut s = format!("OFF\n{} {} 0\n", m.n_vertices(), m.n_faces());
-    for p in &m.positions {
-        // `{:?}` of f64 is the shortest string that round-trips exactly.
-        let _ = writeln!(s, "{:?} {:?} {:?}", p.x, p.y, p.z);
-    }
-    for t in &m.triangles {
-        let _ = writeln!(s, "3 {} {} {}", t[0].0, t[1].0, t[2].0);
-    }
-    std::fs::write(path, s).expect("write OFF");
+    io::write_mesh(path, m).unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
 }
 
-fn read_simple(path: &Path) -> TriMesh {
-    let text = std::fs::read_to_string(path).expect("read mesh");
-    let mut pos = Vec::new();
-    let mut tris: Vec<[usize; 3]> = Vec::new();
-    let fan = |poly: &[usize], tris: &mut Vec<[usize; 3]>| {
-        for k in 1..poly.len().saturating_sub(1) {
-            tris.push([poly[0], poly[k], poly[k + 1]]);
-        }
-    };
-    if path.extension().and_then(|e| e.to_str()) == Some("off") {
-        let toks: Vec<&str> = text
-            .lines()
-            .map(|l| l.split('#').next().unwrap_or(""))
-            .flat_map(str::split_whitespace)
-            .collect();
-        assert_eq!(toks[0], "OFF", "{}", path.display());
-        let num = |i: usize| -> usize { toks[i].parse().expect("OFF count") };
-        let (nv, nf) = (num(1), num(2));
-        let mut i = 4;
-        for _ in 0..nv {
-            let c: Vec<f64> = (0..3)
-                .map(|k| toks[i + k].parse().expect("coord"))
-                .collect();
-            pos.push(Point3::new(c[0], c[1], c[2]));
-            i += 3;
-        }
-        for _ in 0..nf {
-            let n = num(i);
-            let poly: Vec<usize> = (1..=n).map(|k| num(i + k)).collect();
-            fan(&poly, &mut tris);
-            i += n + 1;
-        }
-    } else {
-        for line in text.lines() {
-            let mut it = line.split_whitespace();
-            match it.next() {
-                Some("v") => {
-                    let c: Vec<f64> = it.take(3).map(|x| x.parse().expect("coord")).collect();
-                    pos.push(Point3::new(c[0], c[1], c[2]));
-                }
-                Some("f") => {
-                    let poly: Vec<usize> = it
-                        .map(|c| {
-                            let i: i64 = c.split('/').next().unwrap_or("").parse().expect("index");
-                            if i < 0 {
-                                (pos.len() as i64 + i) as usize
-                            } else {
-                                (i - 1) as usize
-                            }
-                        })
-                        .collect();
-                    fan(&poly, &mut tris);
-                }
-                _ => {}
-            }
-        }
-    }
-    TriMesh::from_indices(pos, &tris).expect("shared meshes are valid arrays")
+fn read(path: &Path) -> TriMesh {
+    io::read_mesh(path)
+        .unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
+        .mesh
 }
 
 // ---------------------------------------------------------------------------------------
 // conemesh's verdicts.
-
-/// Exactly zero area: all three coordinate projections are collinear (exact orient2d).
-fn degenerate_faces(m: &TriMesh) -> Vec<usize> {
-    m.faces()
-        .filter(|&f| {
-            let [a, b, c] = m.face_points(f);
-            let proj = |k: usize, p: &Point3<f64>| Point2::new(p[(k + 1) % 3], p[(k + 2) % 3]);
-            (0..3).all(|k| orient2d(&proj(k, &a), &proj(k, &b), &proj(k, &c)) == Sign::Zero)
-        })
-        .map(FaceId::idx)
-        .collect()
-}
 
 /// Compare conemesh with the checker's JSON; returns one line per disagreement.
 fn compare(case: &str, m: &TriMesh, cgal: &Value) -> Vec<String> {
@@ -245,30 +178,33 @@ fn compare(case: &str, m: &TriMesh, cgal: &Value) -> Vec<String> {
         eq("closed", topo.boundary_loops().is_empty().into());
         eq("boundary_cycles", topo.boundary_loops().len().into());
     }
-    let deg = degenerate_faces(m);
-    eq("degenerate_faces", deg.clone().into());
-    // CGAL's (f, f) pairs are its degenerate faces (see module doc).
-    let cgal_pairs: Vec<(usize, usize)> = cgal["self_intersecting_pairs"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .map(|p| {
-                    (
-                        p[0].as_u64().unwrap_or(u64::MAX) as usize,
-                        p[1].as_u64().unwrap_or(u64::MAX) as usize,
-                    )
-                })
-                .collect()
-        })
-        .unwrap_or_default();
-    let cgal_self: Vec<usize> = cgal_pairs
-        .iter()
-        .filter(|p| p.0 == p.1)
-        .map(|p| p.0)
+    let deg: Vec<usize> = invariants::degenerate_faces(m)
+        .into_iter()
+        .map(FaceId::idx)
         .collect();
-    if cgal_self != deg {
+    eq("degenerate_faces", deg.into());
+    // Same convention on both sides: a degenerate face f is the pair (f, f) and takes no
+    // further part; other pairs (f, g) with f < g, sorted.
+    let pairs: Vec<[usize; 2]> = invariants::self_intersections(m)
+        .into_iter()
+        .map(|(f, g)| [f.idx(), g.idx()])
+        .collect();
+    eq("self_intersects", (!pairs.is_empty()).into());
+    eq("self_intersecting_pairs", pairs.clone().into());
+    // The whole verdict: a valid polygon mesh (manifold, oriented) without self-intersections.
+    let manifold_oriented = invariants::certify_manifold(m, &topo).is_ok()
+        && invariants::certify_oriented(m, &topo).is_ok();
+    if manifold_oriented != valid {
         diffs.push(format!(
-            "{case}: CGAL (f,f) pairs {cgal_self:?} vs conemesh degenerate faces {deg:?}"
+            "{case}: certify_manifold+certify_oriented say {manifold_oriented}, Topology says {valid}"
+        ));
+    }
+    let ours_ok = manifold_oriented && pairs.is_empty();
+    let cgal_ok = cgal["valid_polygon_mesh"] == Value::Bool(true)
+        && cgal["self_intersects"] == Value::Bool(false);
+    if ours_ok != cgal_ok {
+        diffs.push(format!(
+            "{case}: overall validity: conemesh {ours_ok} vs CGAL {cgal_ok}"
         ));
     }
     diffs
@@ -593,7 +529,7 @@ fn shared_meshes_agree_with_cgal() {
     );
     let mut diffs = Vec::new();
     for p in &paths {
-        let m = read_simple(p);
+        let m = read(p);
         let cgal = run_checker(p, &[]);
         let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("?");
         diffs.extend(compare(name, &m, &cgal));
