@@ -135,15 +135,17 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
                             let wt = int(vt, l, path, F)?;
                             match (resolve(wt, vts.len()), corner_vt.as_mut()) {
                                 (Some(r), Some(c)) => c.push((v as usize, r)),
-                                (None, _) => return Err(IoError::Parse {
-                                    path: path.to_string(),
-                                    format: F,
-                                    line: l,
-                                    message: format!(
+                                (None, _) => {
+                                    return Err(IoError::Parse {
+                                        path: path.to_string(),
+                                        format: F,
+                                        line: l,
+                                        message: format!(
                                         "face {f}: texture index {wt} does not exist ({} defined)",
                                         vts.len()
                                     ),
-                                }),
+                                    })
+                                }
                                 _ => {}
                             }
                         }
