@@ -23,6 +23,7 @@
 //! - conemesh's "valid" (manifold, consistently oriented, no self-intersection, no
 //!   degenerate face) is compared with CGAL's `valid_polygon_mesh && !self_intersects`.
 
+use conemesh::check::{check_mesh, CheckOptions, FIRST_FEW};
 use conemesh::mesh::generators;
 use conemesh::predicates::{orient2d, segments_intersect, SegmentIntersection, Sign};
 use conemesh::{invariants, io, FaceId, Topology, TriMesh, VertexId};
@@ -206,6 +207,54 @@ fn compare(case: &str, m: &TriMesh, cgal: &Value) -> Vec<String> {
         diffs.push(format!(
             "{case}: overall validity: conemesh {ours_ok} vs CGAL {cgal_ok}"
         ));
+    }
+    // `conemesh check`'s report (what the CLI prints) against the same witness.
+    let rep = check_mesh(
+        m,
+        &CheckOptions {
+            self_intersections: true,
+        },
+    );
+    let cgal_distinct: Vec<[usize; 2]> = pairs.iter().copied().filter(|p| p[0] != p[1]).collect();
+    let rep_first: Vec<[usize; 2]> = rep
+        .self_intersections
+        .as_ref()
+        .map(|s| s.first.iter().map(|p| [p.0.idx(), p.1.idx()]).collect())
+        .unwrap_or_default();
+    let ours = (
+        rep.valid,
+        rep.components,
+        rep.euler,
+        rep.degenerate_faces,
+        rep.self_intersections.as_ref().map(|s| s.pairs),
+        rep_first,
+    );
+    let theirs = (
+        cgal_ok,
+        cgal["connected_components"].as_u64().unwrap_or(u64::MAX) as usize,
+        cgal["euler_characteristic"].as_i64().unwrap_or(i64::MIN),
+        cgal["degenerate_faces"]
+            .as_array()
+            .map_or(usize::MAX, Vec::len),
+        Some(cgal_distinct.len()),
+        cgal_distinct
+            .into_iter()
+            .take(FIRST_FEW)
+            .collect::<Vec<_>>(),
+    );
+    if ours != theirs {
+        diffs.push(format!(
+            "{case}: check_mesh (valid, components, euler, degenerate, pairs, first pairs) \
+             {ours:?} vs CGAL {theirs:?}"
+        ));
+    }
+    if valid {
+        if rep.boundary_loops as u64 != cgal["boundary_cycles"].as_u64().unwrap_or(u64::MAX) {
+            diffs.push(format!(
+                "{case}: check_mesh boundary loops {} vs CGAL {}",
+                rep.boundary_loops, cgal["boundary_cycles"]
+            ));
+        }
     }
     diffs
 }
