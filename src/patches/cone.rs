@@ -6,8 +6,10 @@
 //! fitted to the seed's whole 1-ring (Eq. 2); the seed triangle s_P is the *unprocessed*
 //! 1-ring face of least E (so every patch contains an unprocessed face, which the loop of
 //! Algorithm 1 needs to terminate). Growth starts from s_P alone (the 1-ring may not be a
-//! disk, or may be partly processed), through unprocessed faces (Eq. 3, `grow.rs`); then the
-//! patch expands into processed faces (`expand.rs`).
+//! disk, or may be partly processed), through unprocessed faces (Eq. 3, `grow.rs`); the cone
+//! is then refitted to the grown patch and growth resumed (`ConeOptions::refit_rounds`);
+//! finally the patch expands into processed faces (`expand.rs`). `Patch::cone` is the cone
+//! of the last growth round that added faces.
 
 use super::cone_fit::{fit_cone, least_error_face};
 use super::expand::expand_rings;
@@ -122,6 +124,17 @@ impl PatchStrategy for ConePatches {
             )));
         };
         let mut grown = grow_patch(ctx, seed_face, &cone, &self.options);
+        let mut cone = cone;
+        for _ in 0..self.options.refit_rounds {
+            if grown.patch.len() < 3 {
+                break;
+            }
+            let refit = fit_cone(ctx.mesh, grown.patch.faces());
+            if grown.grow(&refit, &self.options) == 0 {
+                break;
+            }
+            cone = refit;
+        }
         let max_cost = grown.max_cost();
         expand_rings(&mut grown.patch, ctx.processed, self.options.expand_rings);
         finish_patch(

@@ -42,23 +42,31 @@ pub fn fit_cone_normals(normals: &[Vector3<f64>], weights: &[f64]) -> Cone {
             k = i;
         }
     }
-    // Degenerate minimisers: when several eigenvalues tie with the smallest (all normals
-    // equal: a plane; every `n` is then optimal), take the direction of that eigenspace
-    // closest to the mean normal, so a plane gets its normal as axis and α = 0.
+    // Degenerate minimisers, when eigenvalues tie with the smallest (float tolerance: this
+    // picks among equally good minimisers, it decides no sign):
+    // - three tied (all normals equal, a plane): every `n` is optimal; take the mean normal,
+    //   so a plane is the cone with α = 0 around its normal;
+    // - two tied (exactly two distinct normals, e.g. the 1-ring of a vertex on a
+    //   triangulated cylinder or cone, whose quads are planar): every `n` with
+    //   ⟨n, n₁⟩ = ⟨n, n₂⟩ is optimal; take the one orthogonal to the mean normal, `n₁ × n₂`:
+    //   the cylinder whose axis is the shared ruling (α = 90°).
     let tie = eig.eigenvalues[k] + 1e-12 * total;
-    let mut proj = Vector3::zeros();
-    let mut n_tied = 0;
-    for i in 0..3 {
-        if eig.eigenvalues[i] <= tie {
-            let e: Vector3<f64> = eig.eigenvectors.column(i).into_owned();
-            proj += e * e.dot(&mean);
-            n_tied += 1;
+    let tied: Vec<Vector3<f64>> = (0..3)
+        .filter(|&i| eig.eigenvalues[i] <= tie)
+        .map(|i| eig.eigenvectors.column(i).into_owned())
+        .collect();
+    let mut axis: Vector3<f64> = match tied.len() {
+        3 if mean.norm() > 1e-9 => mean,
+        2 => {
+            let (e1, e2) = (tied[0], tied[1]);
+            let d = e1 * e2.dot(&mean) - e2 * e1.dot(&mean);
+            if d.norm() > 1e-9 {
+                d
+            } else {
+                eig.eigenvectors.column(k).into_owned()
+            }
         }
-    }
-    let mut axis: Vector3<f64> = if n_tied > 1 && proj.norm() > 1e-9 {
-        proj
-    } else {
-        eig.eigenvectors.column(k).into_owned()
+        _ => eig.eigenvectors.column(k).into_owned(),
     };
     let l = axis.norm();
     if l > 0.0 {
@@ -217,6 +225,19 @@ mod tests {
         for n in &normals {
             assert!(cone_error(&cone, n) < 1e-18);
         }
+    }
+
+    #[test]
+    fn two_distinct_normals_give_the_cylinder_through_their_ruling() {
+        let n1 = Vector3::new(1.0, 0.0, 0.0);
+        let n2 = Vector3::new(0.6, 0.8, 0.0);
+        let cone = fit_cone_normals(&[n1, n1, n2], &[1.0, 1.0, 1.0]);
+        assert!(
+            cone.axis.cross(&Vector3::z()).norm() < 1e-9,
+            "{:?}",
+            cone.axis
+        );
+        assert!((cone.angle - std::f64::consts::FRAC_PI_2).abs() < 1e-9);
     }
 
     #[test]

@@ -261,112 +261,122 @@ pub fn grow_patch<'c, 'a>(
     cone: &Cone,
     opts: &ConeOptions,
 ) -> Grown<'c, 'a> {
-    let mesh = ctx.mesh;
-    let mut patch = DiskPatch::new(ctx, seed);
-    let mut distance: HashMap<FaceId, f64> = HashMap::new();
-    distance.insert(seed, 0.0);
-    let mut costs = Vec::new();
-    let centroid = |f: FaceId| mesh.face_centroid(f);
-    let addable = |f: FaceId| !ctx.processed.get(f.idx()).copied().unwrap_or(true);
-
-    // D(s_P, t) for t outside the patch: through its patch neighbours.
-    let d_outside = |patch: &DiskPatch, distance: &HashMap<FaceId, f64>, t: FaceId| -> f64 {
-        let ct = centroid(t);
-        patch
-            .patch_neighbors(t)
-            .filter_map(|(_, g)| distance.get(&g).map(|d| d + (centroid(g) - ct).norm()))
-            .fold(f64::INFINITY, f64::min)
+    let mut g = Grown {
+        patch: DiskPatch::new(ctx, seed),
+        costs: Vec::new(),
+        distance: HashMap::from([(seed, 0.0)]),
     };
-    let cost_of = |patch: &DiskPatch, distance: &HashMap<FaceId, f64>, t: FaceId| -> f64 {
-        let e = cone_error(cone, &mesh.face_normal(t));
-        growth_cost(e, d_outside(patch, distance, t), patch.area(), opts.beta)
-    };
+    g.grow(cone, opts);
+    g
+}
 
-    let mut heap = BinaryHeap::new();
-    for g in patch.adjacent_faces(addable) {
-        heap.push(Entry {
-            cost: cost_of(&patch, &distance, g),
-            face: g,
-            version: patch.len(),
-        });
-    }
-    let max_faces = opts.max_faces.unwrap_or(usize::MAX);
-    while costs.len() < max_faces {
-        let Some(top) = heap.pop() else { break };
-        if patch.contains(top.face) {
-            continue;
-        }
-        if top.version != patch.len() {
+impl Grown<'_, '_> {
+    /// Continue growing with `cone` (e.g. refitted to the patch grown so far); returns the
+    /// number of faces added. `opts.max_faces` bounds the total over all calls.
+    pub fn grow(&mut self, cone: &Cone, opts: &ConeOptions) -> usize {
+        let ctx = self.patch.ctx;
+        let mesh = ctx.mesh;
+        let patch = &mut self.patch;
+        let distance = &mut self.distance;
+        let costs = &mut self.costs;
+        let before = costs.len();
+        let centroid = |f: FaceId| mesh.face_centroid(f);
+        let addable = |f: FaceId| !ctx.processed.get(f.idx()).copied().unwrap_or(true);
+
+        // D(s_P, t) for t outside the patch: through its patch neighbours.
+        let d_outside = |patch: &DiskPatch, distance: &HashMap<FaceId, f64>, t: FaceId| -> f64 {
+            let ct = centroid(t);
+            patch
+                .patch_neighbors(t)
+                .filter_map(|(_, g)| distance.get(&g).map(|d| d + (centroid(g) - ct).norm()))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let cost_of = |patch: &DiskPatch, distance: &HashMap<FaceId, f64>, t: FaceId| -> f64 {
+            let e = cone_error(cone, &mesh.face_normal(t));
+            growth_cost(e, d_outside(patch, distance, t), patch.area(), opts.beta)
+        };
+        let mut heap = BinaryHeap::new();
+        for g in patch.adjacent_faces(addable) {
             heap.push(Entry {
-                cost: cost_of(&patch, &distance, top.face),
-                face: top.face,
+                cost: cost_of(&*patch, &*distance, g),
+                face: g,
                 version: patch.len(),
             });
-            continue;
         }
-        if !(top.cost < opts.c_max) {
-            // Refresh stale entries before giving up.
-            let entries: Vec<Entry> = heap.drain().collect();
-            let mut any_stale = false;
-            for e in entries {
-                if patch.contains(e.face) {
-                    continue;
+        let max_faces = opts.max_faces.unwrap_or(usize::MAX);
+        while costs.len() < max_faces {
+            let Some(top) = heap.pop() else { break };
+            if patch.contains(top.face) {
+                continue;
+            }
+            if top.version != patch.len() {
+                heap.push(Entry {
+                    cost: cost_of(&*patch, &*distance, top.face),
+                    face: top.face,
+                    version: patch.len(),
+                });
+                continue;
+            }
+            if !(top.cost < opts.c_max) {
+                // Refresh stale entries before giving up.
+                let entries: Vec<Entry> = heap.drain().collect();
+                let mut any_stale = false;
+                for e in entries {
+                    if patch.contains(e.face) {
+                        continue;
+                    }
+                    if e.version != patch.len() {
+                        any_stale = true;
+                        heap.push(Entry {
+                            cost: cost_of(&*patch, &*distance, e.face),
+                            face: e.face,
+                            version: patch.len(),
+                        });
+                    } else {
+                        heap.push(e);
+                    }
                 }
-                if e.version != patch.len() {
-                    any_stale = true;
-                    heap.push(Entry {
-                        cost: cost_of(&patch, &distance, e.face),
-                        face: e.face,
-                        version: patch.len(),
-                    });
-                } else {
-                    heap.push(e);
+                if !any_stale {
+                    break;
+                }
+                heap.push(top);
+                continue;
+            }
+            if patch.try_add(top.face).is_err() {
+                // It may become addable later (a pinch can turn into a corner); it is pushed
+                // again when a neighbour joins.
+                continue;
+            }
+            costs.push(top.cost);
+            // Dijkstra inside the patch: the new face's distance, then shortcuts it opens.
+            let d_t = d_outside(&*patch, &*distance, top.face);
+            let d_t = if d_t.is_finite() { d_t } else { 0.0 };
+            distance.insert(top.face, d_t);
+            let mut stack = vec![top.face];
+            while let Some(f) = stack.pop() {
+                let df = distance[&f];
+                let cf = centroid(f);
+                let nbrs: Vec<FaceId> = patch.patch_neighbors(f).map(|(_, g)| g).collect();
+                for g in nbrs {
+                    let cand = df + (centroid(g) - cf).norm();
+                    if cand < distance[&g] {
+                        distance.insert(g, cand);
+                        stack.push(g);
+                    }
                 }
             }
-            if !any_stale {
-                break;
-            }
-            heap.push(top);
-            continue;
-        }
-        if patch.try_add(top.face).is_err() {
-            // It may become addable later (a pinch can turn into a corner); it is pushed
-            // again when a neighbour joins.
-            continue;
-        }
-        costs.push(top.cost);
-        // Dijkstra inside the patch: the new face's distance, then shortcuts it opens.
-        let d_t = d_outside(&patch, &distance, top.face);
-        let d_t = if d_t.is_finite() { d_t } else { 0.0 };
-        distance.insert(top.face, d_t);
-        let mut stack = vec![top.face];
-        while let Some(f) = stack.pop() {
-            let df = distance[&f];
-            let cf = centroid(f);
-            let nbrs: Vec<FaceId> = patch.patch_neighbors(f).map(|(_, g)| g).collect();
-            for g in nbrs {
-                let cand = df + (centroid(g) - cf).norm();
-                if cand < distance[&g] {
-                    distance.insert(g, cand);
-                    stack.push(g);
+            for i in 0..3 {
+                if let Some(g) = ctx.topology.neighbor(top.face, i) {
+                    if !patch.contains(g) && addable(g) {
+                        heap.push(Entry {
+                            cost: cost_of(&*patch, &*distance, g),
+                            face: g,
+                            version: patch.len(),
+                        });
+                    }
                 }
             }
         }
-        for i in 0..3 {
-            if let Some(g) = ctx.topology.neighbor(top.face, i) {
-                if !patch.contains(g) && addable(g) {
-                    heap.push(Entry {
-                        cost: cost_of(&patch, &distance, g),
-                        face: g,
-                        version: patch.len(),
-                    });
-                }
-            }
-        }
-    }
-    Grown {
-        patch,
-        costs,
-        distance,
+        costs.len() - before
     }
 }

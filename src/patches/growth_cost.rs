@@ -24,6 +24,11 @@ pub struct ConeOptions {
     /// Rings of processed faces added after growth (Sec. 4.2, "Expansion of cone patches"),
     /// so consecutive patches overlap. Default 1 (the paper uses 1-2).
     pub expand_rings: usize,
+    /// Refit rounds: after growth stops, refit the cone (Eq. 2) to the whole grown patch and
+    /// grow again, this many times (stopping early when a round adds nothing). The paper
+    /// fits once, from the seed's 1-ring (`0`); a 1-ring often has only two distinct
+    /// normals (planar quads of a cylinder or cone) and then fixes the cone poorly. Default 1.
+    pub refit_rounds: usize,
     /// Upper bound on the faces added by growth (not counting expansion); `None` = no bound.
     /// Default `None` (the paper has none).
     pub max_faces: Option<usize>,
@@ -35,6 +40,7 @@ impl Default for ConeOptions {
             beta: 0.7,
             c_max: 0.1,
             expand_rings: 1,
+            refit_rounds: 1,
             max_faces: None,
         }
     }
