@@ -22,6 +22,18 @@ pub use grow::{grow_patch, DiskPatch, Grown, Refusal};
 pub use growth_cost::{growth_cost, ConeOptions};
 pub use kring::KRingDisks;
 
+/// Names of the built-in strategies, default first (for `--strategy`).
+pub const STRATEGY_NAMES: &[&str] = &["cone", "kring"];
+
+/// A built-in strategy with its default options, by [`PatchStrategy::name`].
+pub fn strategy_by_name(name: &str) -> Option<Box<dyn PatchStrategy>> {
+    match name {
+        "cone" => Some(Box::new(ConePatches::default())),
+        "kring" => Some(Box::new(KRingDisks::default())),
+        _ => None,
+    }
+}
+
 use crate::ids::{EdgeKey, FaceId, PatchId, VertexId};
 use crate::mesh::{Topology, TriMesh};
 use nalgebra::Vector3;
