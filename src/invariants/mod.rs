@@ -113,3 +113,6 @@ pub enum InvariantError {
         reason: String,
     },
 }
+
+mod disk;
+pub use disk::*;

@@ -1,7 +1,38 @@
 //! Patch generation (Sec. 3.2): cone patches and the [`PatchStrategy`] extension point.
 //!
 //! Files: `cone_fit.rs` (Eq. 1-2), `growth_cost.rs` (Eq. 3), `grow.rs` (greedy growth with
-//! the exact disk rule), `expand.rs` (1-2 ring expansion), `cone.rs` (the paper's strategy).
+//! the exact disk rule), `expand.rs` (1-2 ring expansion), `cone.rs` (the paper's strategy),
+//! `kring.rs` (a second strategy), `extract.rs` (a patch as its own mesh), `cover.rs` (the
+//! covering run of `conemesh patches`).
+
+pub mod cone;
+pub mod cone_fit;
+pub mod cover;
+pub mod expand;
+pub mod extract;
+pub mod grow;
+pub mod growth_cost;
+pub mod kring;
+
+pub use cone::ConePatches;
+pub use cone_fit::{cone_error, cone_objective, fit_cone, fit_cone_normals};
+pub use cover::{cover, CoverOptions, CoverRun, PatchStats};
+pub use extract::{extract_patch, PatchMesh};
+pub use grow::{grow_patch, DiskPatch, Grown, Refusal};
+pub use growth_cost::{growth_cost, ConeOptions};
+pub use kring::KRingDisks;
+
+/// Names of the built-in strategies, default first (for `--strategy`).
+pub const STRATEGY_NAMES: &[&str] = &["cone", "kring"];
+
+/// A built-in strategy with its default options, by [`PatchStrategy::name`].
+pub fn strategy_by_name(name: &str) -> Option<Box<dyn PatchStrategy>> {
+    match name {
+        "cone" => Some(Box::new(ConePatches::default())),
+        "kring" => Some(Box::new(KRingDisks::default())),
+        _ => None,
+    }
+}
 
 use crate::ids::{EdgeKey, FaceId, PatchId, VertexId};
 use crate::mesh::{Topology, TriMesh};
@@ -26,6 +57,25 @@ pub enum PatchError {
         seed: VertexId,
         /// the violated invariant
         source: crate::invariants::InvariantError,
+    },
+    /// A face set handed to [`extract_patch`] is not a disk.
+    #[error("not a disk: {0}")]
+    NotADisk(#[source] crate::invariants::InvariantError),
+    /// A strategy returned a patch without unprocessed faces (the loop would not progress).
+    #[error("patch {patch} (seed {seed}) contains no unprocessed face")]
+    NoProgress {
+        /// the patch
+        patch: PatchId,
+        /// its seed vertex
+        seed: VertexId,
+    },
+    /// A strategy returned faces that are not in the mesh.
+    #[error("patch {patch}: face {face} is not in the mesh")]
+    FaceOutOfRange {
+        /// the patch
+        patch: PatchId,
+        /// the face
+        face: FaceId,
     },
 }
 
@@ -52,6 +102,9 @@ pub struct Patch {
     pub seed_face: FaceId,
     /// The fitted cone, for strategies that fit one.
     pub cone: Option<Cone>,
+    /// Largest Eq. 3 cost of a face added by growth (seed and expansion excluded), for
+    /// strategies that grow by cost; always below `c_max`.
+    pub max_growth_cost: Option<f64>,
 }
 
 /// What a strategy sees: the working mesh, its topology, which faces are processed, and

@@ -1,0 +1,299 @@
+//! `certify_disk`: a set of faces is a topological disk (Sec. 3.2, the patch invariant).
+//!
+//! Checked in this order, each failure naming its element: faces distinct; every edge has at
+//! most two patch faces, traversed in opposite directions (edge-manifold, oriented); every
+//! vertex's patch faces form one fan (vertex-manifold, no pinch); the faces are connected
+//! through edges; exactly one boundary loop; Euler characteristic V − E + F = 1. A connected,
+//! oriented, manifold surface with one boundary loop and χ = 1 is a disk (χ = 2 − 2g − b).
+
+use super::InvariantError;
+use crate::ids::{EdgeKey, FaceId, VertexId};
+use crate::mesh::TriMesh;
+use std::collections::HashMap;
+
+fn not_disk(reason: String) -> InvariantError {
+    InvariantError::NotADisk { reason }
+}
+
+fn find(parent: &mut [usize], mut x: usize) -> usize {
+    while parent[x] != x {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    x
+}
+
+fn union(parent: &mut [usize], a: usize, b: usize) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        let (lo, hi) = (ra.min(rb), ra.max(rb));
+        parent[hi] = lo;
+    }
+}
+
+/// Certify that `faces` of `mesh` form a topological disk and return its boundary loop:
+/// an ordered vertex cycle following the patch faces' half-edge direction (the patch lies to
+/// its left), starting at its smallest vertex id.
+///
+/// Errors are [`InvariantError::NotADisk`] whose reason names the offending face, edge
+/// (`edge (v3, v9)`), vertex (`vertex v4`) or count.
+pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, InvariantError> {
+    if faces.is_empty() {
+        return Err(not_disk("no faces".into()));
+    }
+    let mut sorted = faces.to_vec();
+    sorted.sort_unstable();
+    for w in sorted.windows(2) {
+        if w[0] == w[1] {
+            return Err(not_disk(format!("face {} listed twice", w[0])));
+        }
+    }
+    if let Some(f) = sorted.iter().find(|f| f.idx() >= mesh.n_faces()) {
+        return Err(not_disk(format!(
+            "face {f} does not exist (mesh has {} faces)",
+            mesh.n_faces()
+        )));
+    }
+    // Directed edges of the patch, grouped by undirected edge: (from, to, local face index).
+    let mut edges: HashMap<EdgeKey, Vec<(VertexId, VertexId, usize)>> = HashMap::new();
+    for (k, &f) in sorted.iter().enumerate() {
+        let t = mesh.face(f);
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            edges.entry(EdgeKey::new(a, b)).or_default().push((a, b, k));
+        }
+    }
+    let mut keys: Vec<EdgeKey> = edges.keys().copied().collect();
+    keys.sort_unstable();
+    for key in &keys {
+        let hs = &edges[key];
+        if hs.len() > 2 {
+            return Err(not_disk(format!(
+                "edge {key} has {} patch faces (non-manifold)",
+                hs.len()
+            )));
+        }
+        if hs.len() == 2 && hs[0].0 == hs[1].0 {
+            return Err(not_disk(format!(
+                "edge {key}: its two patch faces {} and {} are oriented inconsistently",
+                sorted[hs[0].2], sorted[hs[1].2]
+            )));
+        }
+    }
+    // Vertex-manifold: the patch faces around each vertex form one fan, i.e. are connected
+    // through patch edges at that vertex.
+    let mut vertex_faces: HashMap<VertexId, Vec<usize>> = HashMap::new();
+    for (k, &f) in sorted.iter().enumerate() {
+        for v in mesh.face(f) {
+            vertex_faces.entry(v).or_default().push(k);
+        }
+    }
+    let mut verts: Vec<VertexId> = vertex_faces.keys().copied().collect();
+    verts.sort_unstable();
+    for &v in &verts {
+        let fs = &vertex_faces[&v];
+        if fs.len() <= 1 {
+            continue;
+        }
+        let mut parent: Vec<usize> = (0..fs.len()).collect();
+        for (a, &k) in fs.iter().enumerate() {
+            let t = mesh.face(sorted[k]);
+            for w in t {
+                if w == v {
+                    continue;
+                }
+                for &(_, _, k2) in &edges[&EdgeKey::new(v, w)] {
+                    if k2 != k {
+                        if let Some(b) = fs.iter().position(|&x| x == k2) {
+                            union(&mut parent, a, b);
+                        }
+                    }
+                }
+            }
+        }
+        let fans = (0..fs.len()).filter(|&i| find(&mut parent, i) == i).count();
+        if fans > 1 {
+            return Err(not_disk(format!(
+                "vertex {v} is a pinch: its patch faces form {fans} separate fans"
+            )));
+        }
+    }
+    // Connected through edges.
+    let mut parent: Vec<usize> = (0..sorted.len()).collect();
+    for key in &keys {
+        let hs = &edges[key];
+        if hs.len() == 2 {
+            union(&mut parent, hs[0].2, hs[1].2);
+        }
+    }
+    if let Some(k) = (0..sorted.len()).find(|&k| find(&mut parent, k) != 0) {
+        let n = (0..sorted.len())
+            .filter(|&i| find(&mut parent, i) == i)
+            .count();
+        return Err(not_disk(format!(
+            "not connected: {n} components (faces {} and {} are not joined through edges)",
+            sorted[0], sorted[k]
+        )));
+    }
+    // Boundary loops: boundary half-edges, one outgoing per vertex (vertex-manifold).
+    let mut next: HashMap<VertexId, VertexId> = HashMap::new();
+    for key in &keys {
+        let hs = &edges[key];
+        if hs.len() == 1 {
+            next.insert(hs[0].0, hs[0].1);
+        }
+    }
+    if next.is_empty() {
+        return Err(not_disk(format!(
+            "no boundary: the {} faces form a closed surface",
+            sorted.len()
+        )));
+    }
+    let mut starts: Vec<VertexId> = next.keys().copied().collect();
+    starts.sort_unstable();
+    let mut seen: HashMap<VertexId, usize> = HashMap::new();
+    let mut loops: Vec<Vec<VertexId>> = Vec::new();
+    for &s in &starts {
+        if seen.contains_key(&s) {
+            continue;
+        }
+        let mut lp = vec![s];
+        seen.insert(s, loops.len());
+        let mut v = s;
+        loop {
+            let Some(&w) = next.get(&v) else {
+                return Err(not_disk(format!("boundary is open at vertex {v}")));
+            };
+            if w == s {
+                break;
+            }
+            if seen.contains_key(&w) {
+                return Err(not_disk(format!("boundary revisits vertex {w}")));
+            }
+            seen.insert(w, loops.len());
+            lp.push(w);
+            v = w;
+        }
+        loops.push(lp);
+    }
+    if loops.len() != 1 {
+        let firsts: Vec<String> = loops.iter().map(|l| l[0].to_string()).collect();
+        return Err(not_disk(format!(
+            "{} boundary loops (through vertices {})",
+            loops.len(),
+            firsts.join(", ")
+        )));
+    }
+    let chi = verts.len() as i64 - keys.len() as i64 + sorted.len() as i64;
+    if chi != 1 {
+        return Err(not_disk(format!(
+            "Euler characteristic V − E + F = {} − {} + {} = {chi}, not 1",
+            verts.len(),
+            keys.len(),
+            sorted.len()
+        )));
+    }
+    Ok(loops.pop().unwrap_or_default())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generators;
+    use nalgebra::Point3;
+
+    fn reason(e: InvariantError) -> String {
+        match e {
+            InvariantError::NotADisk { reason } => reason,
+            other => panic!("unexpected error {other}"),
+        }
+    }
+
+    fn all(m: &TriMesh) -> Vec<FaceId> {
+        m.faces().collect()
+    }
+
+    #[test]
+    fn generated_disks_are_certified_with_ccw_boundary() {
+        let d = generators::disk(1.0, 3, 6);
+        let lp = certify_disk(&d, &all(&d)).expect("disk");
+        assert_eq!(lp.len(), 18);
+        let mut a = 0.0;
+        for k in 0..lp.len() {
+            let p = d.positions[lp[k].idx()];
+            let q = d.positions[lp[(k + 1) % lp.len()].idx()];
+            a += p.x * q.y - q.x * p.y;
+        }
+        assert!(a > 0.0, "patch must lie to the left of its boundary");
+        let c = generators::cone_piece(0.5, 2.0, 0.5, 2.0, 6, 4);
+        assert!(certify_disk(&c, &all(&c)).is_ok());
+    }
+
+    #[test]
+    fn rejects_annulus_closed_surface_and_disjoint_triangles() {
+        let cyl = generators::cylinder(1.0, 1.0, 8, 2);
+        let r = reason(certify_disk(&cyl, &all(&cyl)).unwrap_err());
+        assert!(r.starts_with("2 boundary loops"), "{r}");
+        let s = generators::icosphere(1.0, 0);
+        let r = reason(certify_disk(&s, &all(&s)).unwrap_err());
+        assert!(r.starts_with("no boundary"), "{r}");
+        let p = vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, 1.0, 0.0),
+            Point3::new(5.0, 0.0, 0.0),
+            Point3::new(6.0, 0.0, 0.0),
+            Point3::new(5.0, 1.0, 0.0),
+        ];
+        let m = TriMesh::from_indices(p, &[[0, 1, 2], [3, 4, 5]]).unwrap();
+        let r = reason(certify_disk(&m, &all(&m)).unwrap_err());
+        assert!(r.starts_with("not connected: 2 components"), "{r}");
+        assert!(r.contains("f0 and f1"), "{r}");
+    }
+
+    #[test]
+    fn rejects_bowtie_naming_the_pinch_vertex() {
+        let p = vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(1.0, 1.0, 0.0),
+            Point3::new(-1.0, 0.0, 0.0),
+            Point3::new(-1.0, -1.0, 0.0),
+        ];
+        // Two triangles meeting only at v0.
+        let m = TriMesh::from_indices(p, &[[1, 2, 0], [3, 4, 0]]).unwrap();
+        let r = reason(certify_disk(&m, &all(&m)).unwrap_err());
+        assert_eq!(
+            r,
+            "vertex v0 is a pinch: its patch faces form 2 separate fans"
+        );
+    }
+
+    #[test]
+    fn rejects_nonmanifold_edge_flip_and_duplicates() {
+        let p = vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.5, 1.0, 0.0),
+            Point3::new(0.5, -1.0, 0.0),
+            Point3::new(0.5, 0.0, 1.0),
+        ];
+        let m = TriMesh::from_indices(p.clone(), &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap();
+        let r = reason(certify_disk(&m, &all(&m)).unwrap_err());
+        assert!(r.starts_with("edge (v0, v1) has 3 patch faces"), "{r}");
+        let m = TriMesh::from_indices(p, &[[0, 1, 2], [0, 1, 3]]).unwrap();
+        let r = reason(certify_disk(&m, &all(&m)).unwrap_err());
+        assert!(r.starts_with("edge (v0, v1): its two patch faces"), "{r}");
+        let r = reason(certify_disk(&m, &[FaceId(0), FaceId(0)]).unwrap_err());
+        assert_eq!(r, "face f0 listed twice");
+    }
+
+    #[test]
+    fn rejects_torus_with_a_hole_by_euler_characteristic() {
+        let t = generators::torus(2.0, 0.5, 8, 6);
+        let faces: Vec<FaceId> = t.faces().skip(1).collect();
+        let r = reason(certify_disk(&t, &faces).unwrap_err());
+        assert!(r.starts_with("Euler characteristic"), "{r}");
+        assert!(r.ends_with("= -1, not 1"), "{r}");
+    }
+}

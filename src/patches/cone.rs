@@ -1,0 +1,150 @@
+//! The paper's strategy (Sec. 3.2 + 4.2): cone patches.
+//!
+//! Seed vertex: the first is drawn with the RNG among the vertices of unprocessed faces;
+//! later ones on the boundary of the processed region (a vertex shared by a processed and an
+//! unprocessed face, Sec. 4.2), drawn with the RNG among those, in id order. The cone is
+//! fitted to the seed's whole 1-ring (Eq. 2); the seed triangle s_P is the *unprocessed*
+//! 1-ring face of least E (so every patch contains an unprocessed face, which the loop of
+//! Algorithm 1 needs to terminate). Growth starts from s_P alone (the 1-ring may not be a
+//! disk, or may be partly processed), through unprocessed faces (Eq. 3, `grow.rs`); the cone
+//! is then refitted to the grown patch and growth resumed (`ConeOptions::refit_rounds`);
+//! finally the patch expands into processed faces (`expand.rs`). `Patch::cone` is the cone
+//! of the last growth round that added faces.
+
+use super::cone_fit::{fit_cone, least_error_face};
+use super::expand::expand_rings;
+use super::grow::{grow_patch, DiskPatch};
+use super::growth_cost::ConeOptions;
+use super::{Cone, Patch, PatchContext, PatchError, PatchStrategy};
+use crate::ids::{FaceId, VertexId};
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+/// The next seed vertex (see module docs), or `None` when every face is processed.
+pub fn pick_seed_vertex(ctx: &PatchContext<'_>, rng: &mut ChaCha8Rng) -> Option<VertexId> {
+    let mesh = ctx.mesh;
+    let processed = |f: FaceId| ctx.processed.get(f.idx()).copied().unwrap_or(false);
+    let mut free: Vec<VertexId> = Vec::new();
+    let mut any_processed = false;
+    for f in mesh.faces() {
+        if processed(f) {
+            any_processed = true;
+        } else {
+            free.extend(mesh.face(f));
+        }
+    }
+    if free.is_empty() {
+        return None;
+    }
+    free.sort_unstable();
+    free.dedup();
+    let mut candidates = free.clone();
+    if any_processed {
+        let front: Vec<VertexId> = free
+            .iter()
+            .copied()
+            .filter(|&v| ctx.topology.vertex_faces(v).iter().any(|&f| processed(f)))
+            .collect();
+        // Processed and unprocessed regions may not touch (another component): fall back.
+        if !front.is_empty() {
+            candidates = front;
+        }
+    }
+    Some(candidates[rng.random_range(0..candidates.len())])
+}
+
+/// The seed vertex's unprocessed 1-ring faces, sorted.
+pub fn unprocessed_ring(ctx: &PatchContext<'_>, v: VertexId) -> Vec<FaceId> {
+    let mut ring: Vec<FaceId> = ctx
+        .topology
+        .vertex_faces(v)
+        .iter()
+        .copied()
+        .filter(|f| !ctx.processed.get(f.idx()).copied().unwrap_or(true))
+        .collect();
+    ring.sort_unstable();
+    ring
+}
+
+/// Turn a grown disk into a certified [`Patch`].
+pub(crate) fn finish_patch(
+    disk: &DiskPatch<'_, '_>,
+    ctx: &PatchContext<'_>,
+    seed_vertex: VertexId,
+    seed_face: FaceId,
+    cone: Option<Cone>,
+    max_growth_cost: Option<f64>,
+) -> Result<Patch, PatchError> {
+    let faces = disk.sorted_faces();
+    let boundary = crate::invariants::certify_disk(ctx.mesh, &faces).map_err(|source| {
+        PatchError::NotCertified {
+            patch: crate::ids::PatchId(u32::MAX),
+            seed: seed_vertex,
+            source,
+        }
+    })?;
+    Ok(Patch {
+        faces,
+        boundary,
+        seed_vertex,
+        seed_face,
+        cone,
+        max_growth_cost,
+    })
+}
+
+/// Cone patches (the paper, Sec. 3.2): name `cone`, the default strategy.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ConePatches {
+    /// Growth and expansion options.
+    pub options: ConeOptions,
+}
+
+impl PatchStrategy for ConePatches {
+    fn name(&self) -> &'static str {
+        "cone"
+    }
+
+    fn next_patch(
+        &self,
+        ctx: &PatchContext<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Option<Patch>, PatchError> {
+        let Some(seed_vertex) = pick_seed_vertex(ctx, rng) else {
+            return Ok(None);
+        };
+        // Eq. 2 on the full 1-ring Ω_f.
+        let mut omega: Vec<FaceId> = ctx.topology.vertex_faces(seed_vertex).to_vec();
+        omega.sort_unstable();
+        let cone = fit_cone(ctx.mesh, &omega);
+        let candidates = unprocessed_ring(ctx, seed_vertex);
+        let Some(seed_face) = least_error_face(ctx.mesh, &cone, &candidates) else {
+            return Err(PatchError::InvalidMesh(format!(
+                "seed vertex {seed_vertex} has no unprocessed face"
+            )));
+        };
+        let mut grown = grow_patch(ctx, seed_face, &cone, &self.options);
+        let mut cone = cone;
+        for _ in 0..self.options.refit_rounds {
+            if grown.patch.len() < 3 {
+                break;
+            }
+            let refit = fit_cone(ctx.mesh, grown.patch.faces());
+            if grown.grow(&refit, &self.options) == 0 {
+                break;
+            }
+            cone = refit;
+        }
+        let max_cost = grown.max_cost();
+        expand_rings(&mut grown.patch, ctx.processed, self.options.expand_rings);
+        finish_patch(
+            &grown.patch,
+            ctx,
+            seed_vertex,
+            seed_face,
+            Some(cone),
+            Some(max_cost),
+        )
+        .map(Some)
+    }
+}
