@@ -105,3 +105,6 @@ pub enum InvariantError {
         reason: String,
     },
 }
+
+mod bijective;
+pub use bijective::*;
