@@ -116,3 +116,5 @@ pub enum InvariantError {
 
 mod disk;
 pub use disk::*;
+mod bijective;
+pub use bijective::*;

@@ -1,0 +1,675 @@
+//! The default parameterizer of Sec. 3.3: Tutte initialisation, then the area-weighted
+//! symmetric Dirichlet energy minimised with a free boundary by projected Newton, with the
+//! boundary barrier of ref. [30] and an exact certificate after every accepted step.
+//!
+//! * Energy per triangle (Smith & Schaefer 2015): `E(F) = σ1² + σ2² + σ1⁻² + σ2⁻²`, which
+//!   for a 2×2 Jacobian is `‖F‖² (1 + det(F)⁻²)`; it is 4 for an isometry and ∞ on a flip.
+//! * Newton: the 4×4 Hessian in `F` has the analytic eigensystem of isotropic energies
+//!   (Smith, de Goes, Kim 2019); for this energy only the twist mode can be negative, with
+//!   eigenvalue `2 − 2(‖F‖² − J)/J³`, and it is clamped to 0 (projection to PSD). Assembly
+//!   uses a sparsity pattern fixed at start and one symbolic Cholesky reused every step.
+//! * Boundary barrier (ref. [30], Su et al.): for every boundary vertex `p` and boundary edge
+//!   `ab` not incident to it, the triangle-inequality gap `d = |p−a| + |p−b| − |a−b|`
+//!   (zero exactly when `p` touches the edge) enters `(ε/d − 1)²` while `d < ε`, with `ε`
+//!   a fraction of the mean edge length. Its Hessian is the Gauss–Newton term, kept on the
+//!   2×2 diagonal blocks so the sparsity pattern does not change.
+//! * Line search: the largest flip-free step (smallest positive root of `det J(t) = 0` over
+//!   all triangles) times `step_fraction`, then Armijo backtracking; a trial is accepted only
+//!   if `certify_bijective` (exact) passes, so every iterate is certified.
+
+use super::distortion::{jacobian, triangle_frames, TriangleFrame};
+use super::tutte::{certified_tutte, scale_to_area, TutteWeights};
+use super::{certify, distortion, validate_disk, ParamError, Parameterization, Parameterizer};
+use crate::ids::VertexId;
+use crate::mesh::TriMesh;
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Mat, Side};
+use nalgebra::{Matrix4, Point2, Vector2, Vector4};
+
+/// Options of [`SymmetricDirichlet`] (defaults in brackets).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct SdOptions {
+    /// Weights of the Tutte initial map [`TutteWeights::MeanValue`].
+    pub init_weights: TutteWeights,
+    /// Newton iteration budget [50]; running out is reported (`hit_budget`), not an error.
+    pub max_iters: usize,
+    /// Stop when the relative energy decrease of a step is below this [1e-4].
+    pub rel_tol: f64,
+    /// Fraction of the largest flip-free step tried first [0.9].
+    pub step_fraction: f64,
+    /// Armijo sufficient-decrease constant [1e-4].
+    pub armijo: f64,
+    /// Barrier activation distance `ε` on the triangle-inequality gap, as a fraction of the
+    /// mean 3D edge length [0.02].
+    pub barrier_distance: f64,
+    /// Weight of one barrier term relative to one average triangle's energy share [1.0].
+    pub barrier_weight: f64,
+}
+
+impl Default for SdOptions {
+    fn default() -> Self {
+        SdOptions {
+            init_weights: TutteWeights::MeanValue,
+            max_iters: 50,
+            rel_tol: 1e-4,
+            step_fraction: 0.9,
+            armijo: 1e-4,
+            barrier_distance: 0.02,
+            barrier_weight: 1.0,
+        }
+    }
+}
+
+/// Symmetric Dirichlet parameterizer (name `"sd"`), the default [`Parameterizer`].
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct SymmetricDirichlet {
+    /// Options.
+    pub options: SdOptions,
+}
+
+/// Iteration log of [`optimize_with_log`]. Index 0 is the initial map.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SdLog {
+    /// Objective (mean symmetric Dirichlet energy + barrier) of every accepted iterate.
+    pub energies: Vec<f64>,
+    /// Smallest doubled signed triangle area of every accepted iterate (float).
+    pub min_double_area: Vec<f64>,
+    /// Accepted step length (fraction of the Newton step) of each iteration.
+    pub steps: Vec<f64>,
+    /// Newton iterations taken.
+    pub iterations: usize,
+    /// The budget ran out before the stopping rule was met.
+    pub hit_budget: bool,
+    /// A step was wanted but no trial passed the certificate: the last certified iterate
+    /// was returned.
+    pub fell_back: bool,
+    /// Trials rejected by the exact certificate (after passing the float tests).
+    pub certificate_rejections: usize,
+}
+
+/// The fixed sparsity pattern of the 2n×2n Hessian (dof `2v + c`, full symmetric storage)
+/// and the value slot of every triangle-local entry.
+struct Pattern {
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// 36 slots per triangle, row-major over local dofs `2k + c`.
+    tri_slots: Vec<[u32; 36]>,
+    /// Slots of the 2×2 diagonal block of each vertex.
+    diag_slots: Vec<[u32; 4]>,
+}
+
+impl Pattern {
+    fn new(n: usize, tris: &[[VertexId; 3]]) -> Pattern {
+        let mut adj: Vec<Vec<usize>> = (0..n).map(|v| vec![v]).collect();
+        for t in tris {
+            for a in t {
+                for b in t {
+                    adj[a.idx()].push(b.idx());
+                }
+            }
+        }
+        for a in &mut adj {
+            a.sort_unstable();
+            a.dedup();
+        }
+        let mut col_ptr = Vec::with_capacity(2 * n + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
+        for a in &adj {
+            for _c in 0..2 {
+                for &w in a {
+                    row_idx.push(2 * w);
+                    row_idx.push(2 * w + 1);
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        let slot = |row: usize, col: usize| -> u32 {
+            let (s, e) = (col_ptr[col], col_ptr[col + 1]);
+            // The pattern contains every (row, col) asked for by construction.
+            let k = row_idx[s..e].binary_search(&row).unwrap_or(0);
+            (s + k) as u32
+        };
+        let tri_slots = tris
+            .iter()
+            .map(|t| {
+                let mut s = [0u32; 36];
+                for l1 in 0..6 {
+                    for l2 in 0..6 {
+                        let r = 2 * t[l1 / 2].idx() + l1 % 2;
+                        let c = 2 * t[l2 / 2].idx() + l2 % 2;
+                        s[l1 * 6 + l2] = slot(r, c);
+                    }
+                }
+                s
+            })
+            .collect();
+        let diag_slots = (0..n)
+            .map(|v| {
+                [
+                    slot(2 * v, 2 * v),
+                    slot(2 * v + 1, 2 * v),
+                    slot(2 * v, 2 * v + 1),
+                    slot(2 * v + 1, 2 * v + 1),
+                ]
+            })
+            .collect();
+        Pattern {
+            col_ptr,
+            row_idx,
+            tri_slots,
+            diag_slots,
+        }
+    }
+}
+
+/// Energy, gradient and projected Hessian of one triangle with respect to `vec(F)`
+/// (row-major `a, b, c, d`). `None` when `det F ≤ 0` (infinite energy).
+#[inline]
+fn sd_in_f(f: &nalgebra::Matrix2<f64>, hess: bool) -> Option<(f64, Vector4<f64>, Matrix4<f64>)> {
+    let (a, b, c, d) = (f[(0, 0)], f[(0, 1)], f[(1, 0)], f[(1, 1)]);
+    let j = a * d - b * c;
+    if j.is_nan() || j <= 0.0 {
+        return None;
+    }
+    let n = a * a + b * b + c * c + d * d;
+    let (ij, ij2) = (1.0 / j, 1.0 / (j * j));
+    let e = n * (1.0 + ij2);
+    let fv = Vector4::new(a, b, c, d);
+    // g = ∂J/∂vec(F) = vec(cof F).
+    let gv = Vector4::new(d, -c, -b, a);
+    let grad = fv * (2.0 * (1.0 + ij2)) - gv * (2.0 * n * ij2 * ij);
+    if !hess {
+        return Some((e, grad, Matrix4::zeros()));
+    }
+    let ij3 = ij2 * ij;
+    let mut h = Matrix4::identity() * (2.0 * (1.0 + ij2))
+        - (fv * gv.transpose() + gv * fv.transpose()) * (4.0 * ij3)
+        + gv * gv.transpose() * (6.0 * n * ij2 * ij2);
+    // −2 n J⁻³ ∂²J/∂vec(F)² (constant: +1 on (a,d), −1 on (b,c)).
+    let k = 2.0 * n * ij3;
+    h[(0, 3)] -= k;
+    h[(3, 0)] -= k;
+    h[(1, 2)] += k;
+    h[(2, 1)] += k;
+    // Project: the twist eigenvalue (Ψ1 + Ψ2)/(σ1 + σ2) = 2 − 2(n − J)/J³ is the only one
+    // that can be negative; its eigenvector is vec(R90 · R), R the polar rotation of F.
+    let twist = 2.0 - 2.0 * (n - j) * ij3;
+    if twist < 0.0 {
+        let (cs, sn) = (a + d, c - b);
+        let r = cs.hypot(sn);
+        if r > 0.0 {
+            let (cs, sn) = (cs / r, sn / r);
+            let q = Vector4::new(-sn, -cs, cs, -sn) * std::f64::consts::FRAC_1_SQRT_2;
+            h += q * q.transpose() * (-twist);
+        }
+    }
+    Some((e, grad, h))
+}
+
+/// Boundary barrier (ref. [30]): `φ(d) = (ε/d − 1)²` for `0 < d < ε` on the
+/// triangle-inequality gap `d`. Returns the active terms as `(p, a, b, d)` (vertex indices).
+fn barrier_pairs(
+    uv: &[Point2<f64>],
+    boundary: &[VertexId],
+    eps: f64,
+) -> Vec<(usize, usize, usize, f64)> {
+    let m = boundary.len();
+    let mut out = Vec::new();
+    if m < 4 || eps <= 0.0 {
+        return out;
+    }
+    // Vertices sorted by x; each edge looks up the x-range of its ellipse {d < ε}, whose
+    // half-width beyond the segment is at most √(Lε + ε²)/2.
+    let mut by_x: Vec<(f64, usize)> = (0..m).map(|i| (uv[boundary[i].idx()].x, i)).collect();
+    by_x.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    for e in 0..m {
+        let (ia, ib) = (boundary[e].idx(), boundary[(e + 1) % m].idx());
+        let (a, b) = (uv[ia], uv[ib]);
+        let l = (b - a).norm();
+        let r = 0.5 * (l * eps + eps * eps).sqrt() * 1.000_001;
+        let (x0, x1) = (a.x.min(b.x) - r, a.x.max(b.x) + r);
+        let (y0, y1) = (a.y.min(b.y) - r, a.y.max(b.y) + r);
+        let start = by_x.partition_point(|x| x.0 < x0);
+        for &(px, k) in &by_x[start..] {
+            if px > x1 {
+                break;
+            }
+            if k == e || k == (e + 1) % m {
+                continue;
+            }
+            let ip = boundary[k].idx();
+            let p = uv[ip];
+            if p.y < y0 || p.y > y1 {
+                continue;
+            }
+            let d = (p - a).norm() + (p - b).norm() - l;
+            if d < eps {
+                out.push((ip, ia, ib, d.max(0.0)));
+            }
+        }
+    }
+    out
+}
+
+/// The optimisation problem: rest frames, pattern, scales.
+struct Problem<'a> {
+    tris: &'a [[VertexId; 3]],
+    frames: Vec<TriangleFrame>,
+    boundary: &'a [VertexId],
+    total_area: f64,
+    eps: f64,
+    barrier_w: f64,
+}
+
+impl Problem<'_> {
+    /// Objective: Σ A_t E_t / A + w Σ φ(d). ∞ if a triangle is flipped (float) or a barrier
+    /// gap is zero.
+    fn energy(&self, uv: &[Point2<f64>]) -> f64 {
+        let mut e = 0.0;
+        for (t, fr) in self.tris.iter().zip(&self.frames) {
+            if fr.area <= 0.0 {
+                continue;
+            }
+            let f = jacobian(fr, [uv[t[0].idx()], uv[t[1].idx()], uv[t[2].idx()]]);
+            match sd_in_f(&f, false) {
+                Some((et, _, _)) => e += fr.area * et,
+                None => return f64::INFINITY,
+            }
+        }
+        e /= self.total_area;
+        for (_, _, _, d) in barrier_pairs(uv, self.boundary, self.eps) {
+            if d <= 0.0 {
+                return f64::INFINITY;
+            }
+            e += self.barrier_w * (self.eps / d - 1.0).powi(2);
+        }
+        e
+    }
+
+    /// Gradient and projected Hessian values (in `pattern` order).
+    fn assemble(
+        &self,
+        uv: &[Point2<f64>],
+        pat: &Pattern,
+        grad: &mut [f64],
+        vals: &mut [f64],
+    ) -> Result<(), ParamError> {
+        grad.iter_mut().for_each(|x| *x = 0.0);
+        vals.iter_mut().for_each(|x| *x = 0.0);
+        for (ti, (t, fr)) in self.tris.iter().zip(&self.frames).enumerate() {
+            if fr.area <= 0.0 {
+                continue;
+            }
+            let f = jacobian(fr, [uv[t[0].idx()], uv[t[1].idx()], uv[t[2].idx()]]);
+            let (_, gf, hf) = sd_in_f(&f, true).ok_or_else(|| {
+                ParamError::NotCertified(format!("f{ti} is flipped during optimisation"))
+            })?;
+            let w = fr.area / self.total_area;
+            let g = &fr.grad;
+            // ∂vec(F)/∂u_{k,i}: entries (i, j) ↦ index 2i + j with coefficient G[k][j].
+            for k in 0..3 {
+                for i in 0..2 {
+                    grad[2 * t[k].idx() + i] += w * (gf[2 * i] * g[k][0] + gf[2 * i + 1] * g[k][1]);
+                }
+            }
+            let slots = &pat.tri_slots[ti];
+            for l1 in 0..6 {
+                let (k, i) = (l1 / 2, l1 % 2);
+                for l2 in 0..6 {
+                    let (l, m) = (l2 / 2, l2 % 2);
+                    let mut s = 0.0;
+                    for jj in 0..2 {
+                        for pp in 0..2 {
+                            s += hf[(2 * i + jj, 2 * m + pp)] * g[k][jj] * g[l][pp];
+                        }
+                    }
+                    vals[slots[l1 * 6 + l2] as usize] += w * s;
+                }
+            }
+        }
+        for (p, a, b, d) in barrier_pairs(uv, self.boundary, self.eps) {
+            if d <= 0.0 {
+                return Err(ParamError::NotCertified(format!(
+                    "boundary vertex v{p} touches boundary edge (v{a}, v{b})"
+                )));
+            }
+            let r = self.eps / d;
+            let d1 = self.barrier_w * 2.0 * (r - 1.0) * (-r / d);
+            let d2 = self.barrier_w * (2.0 * r * r / (d * d) + 4.0 * r * (r - 1.0) / (d * d));
+            let unit = |x: Point2<f64>, y: Point2<f64>| {
+                let v = x - y;
+                let l = v.norm();
+                if l > 0.0 {
+                    v / l
+                } else {
+                    Vector2::zeros()
+                }
+            };
+            let (pp, pa, pb) = (uv[p], uv[a], uv[b]);
+            let gd = [
+                (p, unit(pp, pa) + unit(pp, pb)),
+                (a, unit(pa, pp) - unit(pa, pb)),
+                (b, unit(pb, pp) - unit(pb, pa)),
+            ];
+            for (v, gv) in gd {
+                grad[2 * v] += d1 * gv.x;
+                grad[2 * v + 1] += d1 * gv.y;
+                let s = &pat.diag_slots[v];
+                vals[s[0] as usize] += d2 * gv.x * gv.x;
+                vals[s[1] as usize] += d2 * gv.y * gv.x;
+                vals[s[2] as usize] += d2 * gv.x * gv.y;
+                vals[s[3] as usize] += d2 * gv.y * gv.y;
+            }
+        }
+        Ok(())
+    }
+
+    /// Largest `t` with every triangle's `det(U + t dU) > 0` (∞ if none vanishes).
+    fn max_flip_free_step(&self, uv: &[Point2<f64>], dir: &[f64]) -> f64 {
+        let mut tmax = f64::INFINITY;
+        for t in self.tris {
+            let p = |k: usize| uv[t[k].idx()];
+            let q = |k: usize| Vector2::new(dir[2 * t[k].idx()], dir[2 * t[k].idx() + 1]);
+            let (e1, e2) = (p(1) - p(0), p(2) - p(0));
+            let (d1, d2) = (q(1) - q(0), q(2) - q(0));
+            // det(U + t dU) = c0 + c1 t + c2 t².
+            let c0 = e1.perp(&e2);
+            let c1 = e1.perp(&d2) + d1.perp(&e2);
+            let c2 = d1.perp(&d2);
+            if let Some(r) = smallest_positive_root(c2, c1, c0) {
+                tmax = tmax.min(r);
+            }
+        }
+        tmax
+    }
+}
+
+/// Smallest positive root of `a t² + b t + c` (numerically stable form), if any.
+fn smallest_positive_root(a: f64, b: f64, c: f64) -> Option<f64> {
+    let mut best: Option<f64> = None;
+    let mut take = |r: f64| {
+        if r > 0.0 && r.is_finite() {
+            best = Some(best.map_or(r, |x: f64| x.min(r)));
+        }
+    };
+    if a.abs() <= 1e-300 || (a.abs() * c.abs() <= 1e-24 * b * b && b != 0.0) {
+        if b != 0.0 {
+            take(-c / b);
+        }
+        if a != 0.0 && b != 0.0 {
+            take(-b / a); // the far root of a nearly linear quadratic
+        }
+        return best;
+    }
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    let s = disc.sqrt();
+    let q = -0.5 * (b + b.signum() * s);
+    if q != 0.0 {
+        take(q / a);
+        take(c / q);
+    } else {
+        take((-c / a).sqrt());
+    }
+    best
+}
+
+fn min_double_area(uv: &[Point2<f64>], tris: &[[VertexId; 3]]) -> f64 {
+    tris.iter()
+        .map(|t| {
+            let (a, b, c) = (uv[t[0].idx()], uv[t[1].idx()], uv[t[2].idx()]);
+            (b - a).perp(&(c - a))
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Minimise the symmetric Dirichlet energy of the certified map `uv0` of `disk` (free
+/// boundary, projected Newton, boundary barrier, certified line search; see the module
+/// docs). Returns the last accepted iterate, which passes `certify_bijective`, and the log.
+/// Errors: `NotCertified` if `uv0` itself does not pass the certificate, `Solver` if the
+/// sparse factorisation fails.
+pub fn optimize_with_log(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    uv0: &[Point2<f64>],
+    options: &SdOptions,
+) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
+    certify(disk, uv0, boundary)?;
+    let n = disk.n_vertices();
+    let frames = triangle_frames(disk);
+    let total_area: f64 = frames.iter().map(|f| f.area).sum();
+    let mut log = SdLog::default();
+    let mut uv = uv0.to_vec();
+    if total_area <= 0.0 {
+        log.energies.push(f64::INFINITY);
+        log.min_double_area
+            .push(min_double_area(&uv, &disk.triangles));
+        return Ok((uv, log));
+    }
+    let prob = Problem {
+        tris: &disk.triangles,
+        frames,
+        boundary,
+        total_area,
+        eps: options.barrier_distance * disk.mean_edge_length(),
+        barrier_w: options.barrier_weight / disk.n_faces() as f64,
+    };
+    let pat = Pattern::new(n, &disk.triangles);
+    let dim = 2 * n;
+    let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
+    let symbolic = SymbolicLlt::try_new(sym, Side::Lower)
+        .map_err(|e| ParamError::Solver(format!("symbolic Cholesky: {e:?}")))?;
+    let mut vals = vec![0.0; pat.row_idx.len()];
+    let mut grad = vec![0.0; dim];
+    let mut energy = prob.energy(&uv);
+    log.energies.push(energy);
+    log.min_double_area
+        .push(min_double_area(&uv, &disk.triangles));
+    let mut converged = false;
+    let mut trial = uv.clone();
+    while log.iterations < options.max_iters {
+        prob.assemble(&uv, &pat, &mut grad, &mut vals)?;
+        // Regularise the projected Hessian (translations and, at an isometry, rotations are
+        // in its null space); grow the shift until the Cholesky factorisation succeeds.
+        let trace: f64 = (0..dim)
+            .map(|v| vals[pat.diag_slots[v / 2][if v % 2 == 0 { 0 } else { 3 }] as usize])
+            .sum();
+        let mut mu = 1e-8 * trace / dim as f64;
+        let mut llt = None;
+        for _ in 0..8 {
+            let mut v = vals.clone();
+            for vv in 0..n {
+                v[pat.diag_slots[vv][0] as usize] += mu;
+                v[pat.diag_slots[vv][3] as usize] += mu;
+            }
+            let mat = SparseColMatRef::new(sym, &v);
+            if let Ok(f) = Llt::try_new_with_symbolic(symbolic.clone(), mat, Side::Lower) {
+                llt = Some(f);
+                break;
+            }
+            mu *= 100.0;
+        }
+        let llt = llt.ok_or_else(|| {
+            ParamError::Solver("Newton Hessian is not positive definite".to_string())
+        })?;
+        let mut rhs = Mat::<f64>::zeros(dim, 1);
+        for i in 0..dim {
+            rhs[(i, 0)] = -grad[i];
+        }
+        let sol = llt.solve(&rhs);
+        let dir: Vec<f64> = (0..dim).map(|i| sol[(i, 0)]).collect();
+        let slope: f64 = dir.iter().zip(&grad).map(|(d, g)| d * g).sum();
+        if !(slope < 0.0) {
+            converged = true; // no descent direction left
+            break;
+        }
+        let mut t = (options.step_fraction * prob.max_flip_free_step(&uv, &dir)).min(1.0);
+        let mut accepted = None;
+        for _ in 0..40 {
+            for v in 0..n {
+                trial[v] = Point2::new(uv[v].x + t * dir[2 * v], uv[v].y + t * dir[2 * v + 1]);
+            }
+            let e = prob.energy(&trial);
+            if e <= energy + options.armijo * t * slope {
+                if certify(disk, &trial, boundary).is_ok() {
+                    accepted = Some(e);
+                    break;
+                }
+                log.certificate_rejections += 1;
+            }
+            t *= 0.5;
+        }
+        let Some(e_new) = accepted else {
+            // No certified decrease along the Newton direction: keep the last certified
+            // iterate. If the direction still promised a real decrease, report a fallback.
+            log.fell_back = -slope > options.rel_tol * energy;
+            converged = !log.fell_back;
+            break;
+        };
+        std::mem::swap(&mut uv, &mut trial);
+        log.iterations += 1;
+        log.steps.push(t);
+        log.energies.push(e_new);
+        log.min_double_area
+            .push(min_double_area(&uv, &disk.triangles));
+        let rel = (energy - e_new) / energy.abs().max(f64::MIN_POSITIVE);
+        energy = e_new;
+        if rel < options.rel_tol {
+            converged = true;
+            break;
+        }
+    }
+    log.hit_budget = !converged && !log.fell_back && log.iterations >= options.max_iters;
+    Ok((uv, log))
+}
+
+impl Parameterizer for SymmetricDirichlet {
+    fn name(&self) -> &'static str {
+        "sd"
+    }
+
+    fn parameterize(
+        &self,
+        disk: &TriMesh,
+        boundary: &[VertexId],
+    ) -> Result<Parameterization, ParamError> {
+        validate_disk(disk, boundary)?;
+        let (uv0, _) = certified_tutte(disk, boundary, self.options.init_weights)?;
+        let (mut uv, log) = optimize_with_log(disk, boundary, &uv0, &self.options)?;
+        let mut fell_back = log.fell_back;
+        // Isometric in the mean: rescale so the 2D area equals the 3D area; a uniform scale
+        // keeps orientations in exact arithmetic, and the certificate is re-checked.
+        let unscaled = uv.clone();
+        scale_to_area(disk, &mut uv);
+        if certify(disk, &uv, boundary).is_err() {
+            uv = unscaled;
+            fell_back = true;
+        }
+        let mut report = distortion(disk, &uv);
+        report.iterations = log.iterations;
+        report.hit_budget = log.hit_budget;
+        report.fell_back = fell_back;
+        Ok(Parameterization { uv, report })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix2, SymmetricEigen};
+
+    fn energy_of(f: &Matrix2<f64>) -> f64 {
+        sd_in_f(f, false).map_or(f64::INFINITY, |x| x.0)
+    }
+
+    #[test]
+    fn gradient_and_hessian_match_finite_differences() {
+        let f = Matrix2::new(1.3, 0.4, -0.2, 0.7);
+        let (_, g, _) = sd_in_f(&f, true).unwrap();
+        let h = 1e-6;
+        for k in 0..4 {
+            let mut fp = f;
+            let mut fm = f;
+            fp[(k / 2, k % 2)] += h;
+            fm[(k / 2, k % 2)] -= h;
+            let fd = (energy_of(&fp) - energy_of(&fm)) / (2.0 * h);
+            assert!(
+                (fd - g[k]).abs() < 1e-6 * (1.0 + g[k].abs()),
+                "{k}: {fd} {}",
+                g[k]
+            );
+        }
+        // Unprojected Hessian (twist ≥ 0 here) against differences of the gradient.
+        let f = Matrix2::new(1.5, 0.1, 0.05, 1.4);
+        let (_, _, hs) = sd_in_f(&f, true).unwrap();
+        for k in 0..4 {
+            let mut fp = f;
+            let mut fm = f;
+            fp[(k / 2, k % 2)] += h;
+            fm[(k / 2, k % 2)] -= h;
+            let gp = sd_in_f(&fp, false).unwrap().1;
+            let gm = sd_in_f(&fm, false).unwrap().1;
+            for r in 0..4 {
+                let fd = (gp[r] - gm[r]) / (2.0 * h);
+                assert!(
+                    (fd - hs[(r, k)]).abs() < 1e-5,
+                    "{r},{k}: {fd} {}",
+                    hs[(r, k)]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn analytic_projection_equals_eigenvalue_clamping() {
+        for f in [
+            Matrix2::new(0.3, 0.1, -0.05, 0.2),
+            Matrix2::new(0.8, -0.3, 0.4, 0.5),
+            Matrix2::new(2.0, 0.0, 0.0, 0.1),
+            Matrix2::new(1.0, 0.0, 0.0, 1.0),
+        ] {
+            let (_, _, hp) = sd_in_f(&f, true).unwrap();
+            // Rebuild the raw Hessian: undo the projection by clamping eigenvalues ourselves.
+            let eig = SymmetricEigen::new(hp);
+            assert!(
+                eig.eigenvalues.iter().all(|&l| l > -1e-9),
+                "{:?}",
+                eig.eigenvalues
+            );
+            // The projection only changes the negative part: hp − h_raw is PSD of rank ≤ 1
+            // and hp equals the clamped eigen-decomposition of h_raw.
+            let j = f.determinant();
+            let n = f.norm_squared();
+            let twist = 2.0 - 2.0 * (n - j) / (j * j * j);
+            let (cs, sn) = (f[(0, 0)] + f[(1, 1)], f[(1, 0)] - f[(0, 1)]);
+            let r = cs.hypot(sn);
+            let q = Vector4::new(-sn / r, -cs / r, cs / r, -sn / r) / 2f64.sqrt();
+            let raw = if twist < 0.0 {
+                hp - q * q.transpose() * (-twist)
+            } else {
+                hp
+            };
+            // q is an eigenvector of the raw Hessian with eigenvalue `twist`.
+            let hq = raw * q;
+            assert!((hq - q * twist).norm() < 1e-8 * (1.0 + twist.abs()), "{f}");
+            let e = SymmetricEigen::new(raw);
+            let clamped = e.eigenvectors
+                * Matrix4::from_diagonal(&e.eigenvalues.map(|l| l.max(0.0)))
+                * e.eigenvectors.transpose();
+            assert!((clamped - hp).norm() < 1e-8 * hp.norm(), "{f}");
+        }
+    }
+
+    #[test]
+    fn quadratic_roots() {
+        assert_eq!(smallest_positive_root(1.0, -3.0, 2.0), Some(1.0));
+        assert_eq!(smallest_positive_root(0.0, -2.0, 1.0), Some(0.5));
+        assert_eq!(smallest_positive_root(1.0, 0.0, 1.0), None);
+        assert_eq!(smallest_positive_root(1.0, 3.0, 2.0), None);
+    }
+}
