@@ -105,3 +105,6 @@ pub enum InvariantError {
         reason: String,
     },
 }
+
+mod planar;
+pub use planar::*;

@@ -1,6 +1,12 @@
 //! Planar anisotropic remeshing (Sec. 3.3): metric transfer (Eq. 4), the LCT remesher
 //! (ref. [5]) and the [`PlanarRemesher`] extension point.
 
+mod field;
+mod transfer;
+
+pub use field::PlanarMetricField;
+pub use transfer::{clamp_spd, transfer_metric, TransferMethod, EIGEN_FLOOR_REL};
+
 use nalgebra::{Matrix2, Point2};
 use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
