@@ -118,3 +118,6 @@ mod disk;
 pub use disk::*;
 mod bijective;
 pub use bijective::*;
+
+mod planar;
+pub use planar::*;

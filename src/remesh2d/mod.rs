@@ -1,6 +1,20 @@
 //! Planar anisotropic remeshing (Sec. 3.3): metric transfer (Eq. 4), the LCT remesher
 //! (ref. [5]) and the [`PlanarRemesher`] extension point.
 
+mod demo;
+mod domain;
+mod field;
+mod lct;
+mod stats;
+mod transfer;
+
+pub use demo::{demo_cases, run_demo_case, DemoDomain, DemoMetric};
+pub use domain::{metric_length, resample_polygon, triangulate_polygon};
+pub use field::PlanarMetricField;
+pub use lct::{remesh_planar, Lct, LctOptions};
+pub use stats::{planar_quality, PlanarQuality};
+pub use transfer::{clamp_spd, transfer_metric, TransferMethod, EIGEN_FLOOR_REL};
+
 use nalgebra::{Matrix2, Point2};
 use rand_chacha::ChaCha8Rng;
 use thiserror::Error;

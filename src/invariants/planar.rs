@@ -1,0 +1,345 @@
+//! Certificate of a planar remeshing result (Sec. 3.3): the output triangulates exactly the
+//! input polygon, with the boundary loop and constrained edges kept bit for bit.
+
+use super::InvariantError;
+use crate::predicates::{orient2d, Sign};
+use crate::remesh2d::{PlanarDomain, PlanarMesh};
+use nalgebra::Point2;
+use std::collections::HashMap;
+
+fn invalid(reason: String) -> InvariantError {
+    InvariantError::PlanarInvalid { reason }
+}
+
+/// Names of at most ten elements, then the count of the rest.
+fn list<T: std::fmt::Display>(xs: &[T]) -> String {
+    let mut s: Vec<String> = xs.iter().take(10).map(|x| x.to_string()).collect();
+    if xs.len() > 10 {
+        s.push(format!("… and {} more", xs.len() - 10));
+    }
+    s.join(", ")
+}
+
+/// Twice the signed area of a polygon (shoelace; floating point).
+fn polygon_area2(pts: &[Point2<f64>]) -> f64 {
+    let n = pts.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (pts[i], pts[(i + 1) % n]);
+            a.x * b.y - a.y * b.x
+        })
+        .sum()
+}
+
+/// Exact point-in-polygon: `Some(true)` strictly inside, `Some(false)` strictly outside,
+/// `None` on the boundary. Crossing number along the ray to +x, with every side decision
+/// taken by [`orient2d`] and half-open edges (an edge counts when exactly one endpoint is
+/// strictly above `p`).
+pub fn point_in_polygon(poly: &[Point2<f64>], p: &Point2<f64>) -> Option<bool> {
+    let n = poly.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (&poly[i], &poly[(i + 1) % n]);
+        let o = orient2d(a, b, p);
+        if o == Sign::Zero
+            && p.x >= a.x.min(b.x)
+            && p.x <= a.x.max(b.x)
+            && p.y >= a.y.min(b.y)
+            && p.y <= a.y.max(b.y)
+        {
+            return None;
+        }
+        if (a.y > p.y) != (b.y > p.y) {
+            // The edge straddles the horizontal line through p; it crosses the ray to the right
+            // when p is left of the upward-directed edge.
+            let left = if b.y > a.y {
+                o == Sign::Positive
+            } else {
+                o == Sign::Negative
+            };
+            if left {
+                inside = !inside;
+            }
+        }
+    }
+    Some(inside)
+}
+
+/// Certify a planar remesh `out` of `domain` (Sec. 3.3, invariants of the LCT remesher):
+///
+/// 1. indices in range, coordinates finite, `origin` has one entry per point, every point used;
+/// 2. every triangle positive by exact [`orient2d`];
+/// 3. every boundary vertex of `domain` and every endpoint of a constrained edge appears in `out`
+///    through `origin`, at a bit-identical position (and every `origin` entry is bit-identical);
+/// 4. every edge has one or two faces, interior edges are traversed once each way, and the
+///    boundary half-edges of `out` are exactly the images of the domain's boundary loop
+///    (so `out`'s boundary is that loop, in the same order);
+/// 5. every constrained edge is an edge of `out`;
+/// 6. `out` is a disk: `V − E + F = 1` (with (4), one boundary loop);
+/// 7. total area equals the polygon's up to a relative 1e-9 (floating point sums);
+/// 8. every other vertex lies strictly inside the polygon (exact, [`point_in_polygon`]).
+///
+/// (2) and (4) together already imply an exact tiling of the polygon: a positively oriented
+/// 2-chain whose boundary is a simple loop covers its inside exactly once.
+pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), InvariantError> {
+    let np = out.points.len();
+    if out.origin.len() != np {
+        return Err(invalid(format!(
+            "{} points but {} origin entries",
+            np,
+            out.origin.len()
+        )));
+    }
+    if let Some(i) = out
+        .points
+        .iter()
+        .position(|p| !p.x.is_finite() || !p.y.is_finite())
+    {
+        return Err(invalid(format!("point v{i} is not finite")));
+    }
+    if let Some(f) = out
+        .triangles
+        .iter()
+        .position(|t| t.iter().any(|&i| i as usize >= np))
+    {
+        return Err(invalid(format!("triangle f{f} has an out-of-range vertex")));
+    }
+    // (2) orientation.
+    let bad: Vec<String> = out
+        .triangles
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| {
+            let [a, b, c] = t.map(|i| out.points[i as usize]);
+            orient2d(&a, &b, &c) != Sign::Positive
+        })
+        .map(|(f, _)| format!("f{f}"))
+        .collect();
+    if !bad.is_empty() {
+        return Err(invalid(format!("non-positive triangles: {}", list(&bad))));
+    }
+    // (3) kept vertices.
+    let mut image: HashMap<u32, u32> = HashMap::new();
+    for (i, o) in out.origin.iter().enumerate() {
+        if let Some(j) = *o {
+            let q = domain
+                .points
+                .get(j as usize)
+                .ok_or_else(|| invalid(format!("v{i} has origin v{j}, not an input vertex")))?;
+            let p = out.points[i];
+            if p.x.to_bits() != q.x.to_bits() || p.y.to_bits() != q.y.to_bits() {
+                return Err(invalid(format!(
+                    "v{i} (input v{j}) moved: ({}, {}) instead of ({}, {})",
+                    p.x, p.y, q.x, q.y
+                )));
+            }
+            if image.insert(j, i as u32).is_some() {
+                return Err(invalid(format!("input v{j} appears twice in the output")));
+            }
+        }
+    }
+    let mut kept: Vec<u32> = domain.boundary.clone();
+    kept.extend(domain.constrained_edges.iter().flatten());
+    let missing: Vec<String> = kept
+        .iter()
+        .filter(|v| !image.contains_key(v))
+        .map(|v| format!("input v{v}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(invalid(format!(
+            "boundary/constrained vertices missing: {}",
+            list(&missing)
+        )));
+    }
+    // (4) edges.
+    let mut he: HashMap<(u32, u32), u32> = HashMap::with_capacity(out.triangles.len() * 3);
+    for (f, t) in out.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if he.insert((a, b), f as u32).is_some() {
+                return Err(invalid(format!(
+                    "half-edge (v{a}, v{b}) used twice (f{f}): non-manifold or inconsistent"
+                )));
+            }
+        }
+    }
+    let boundary_he: Vec<(u32, u32)> = he
+        .keys()
+        .filter(|(a, b)| !he.contains_key(&(*b, *a)))
+        .copied()
+        .collect();
+    let nb = domain.boundary.len();
+    let mut expected = Vec::with_capacity(nb);
+    for k in 0..nb {
+        let (a, b) = (domain.boundary[k], domain.boundary[(k + 1) % nb]);
+        // Both are in `image` (checked above).
+        let (ia, ib) = (image[&a], image[&b]);
+        if !he.contains_key(&(ia, ib)) || he.contains_key(&(ib, ia)) {
+            return Err(invalid(format!(
+                "input boundary edge (v{a}, v{b}) is not a boundary edge (v{ia}, v{ib}) of the output"
+            )));
+        }
+        expected.push((ia, ib));
+    }
+    if boundary_he.len() != expected.len() {
+        let mut extra: Vec<(u32, u32)> = boundary_he
+            .iter()
+            .filter(|e| !expected.contains(e))
+            .copied()
+            .collect();
+        extra.sort_unstable();
+        let names: Vec<String> = extra.iter().map(|(a, b)| format!("(v{a}, v{b})")).collect();
+        return Err(invalid(format!(
+            "output has {} boundary edges, input loop has {}; extra: {}",
+            boundary_he.len(),
+            expected.len(),
+            list(&names)
+        )));
+    }
+    // (5) constrained edges.
+    for &[a, b] in &domain.constrained_edges {
+        let (ia, ib) = (image[&a], image[&b]);
+        if !he.contains_key(&(ia, ib)) && !he.contains_key(&(ib, ia)) {
+            return Err(invalid(format!(
+                "constrained edge (v{a}, v{b}) missing (output v{ia}, v{ib})"
+            )));
+        }
+    }
+    // (6) disk: every point used, V − E + F = 1.
+    let mut used = vec![false; np];
+    for t in &out.triangles {
+        for &i in t {
+            used[i as usize] = true;
+        }
+    }
+    if let Some(i) = used.iter().position(|u| !u) {
+        return Err(invalid(format!("v{i} is not used by any triangle")));
+    }
+    let n_edges = (he.len() + boundary_he.len()) / 2;
+    let chi = np as i64 - n_edges as i64 + out.triangles.len() as i64;
+    if chi != 1 {
+        return Err(InvariantError::NotADisk {
+            reason: format!(
+                "planar output has V − E + F = {np} − {n_edges} + {} = {chi}",
+                out.triangles.len()
+            ),
+        });
+    }
+    // (7) area.
+    let poly: Vec<Point2<f64>> = domain
+        .boundary
+        .iter()
+        .map(|&b| domain.points[b as usize])
+        .collect();
+    let a_poly = 0.5 * polygon_area2(&poly);
+    let a_out: f64 = out
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| out.points[i as usize]);
+            0.5 * (b - a).perp(&(c - a))
+        })
+        .sum();
+    if !((a_out - a_poly).abs() <= 1e-9 * a_poly.abs()) {
+        return Err(invalid(format!(
+            "total area {a_out} differs from the polygon's {a_poly}"
+        )));
+    }
+    // (8) interior vertices strictly inside.
+    let on_loop: std::collections::HashSet<u32> = expected.iter().map(|e| e.0).collect();
+    let outside: Vec<String> = (0..np as u32)
+        .filter(|i| !on_loop.contains(i))
+        .filter(|&i| point_in_polygon(&poly, &out.points[i as usize]) != Some(true))
+        .map(|i| format!("v{i}"))
+        .collect();
+    if !outside.is_empty() {
+        return Err(invalid(format!(
+            "interior vertices not strictly inside the polygon: {}",
+            list(&outside)
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> PlanarDomain {
+        PlanarDomain {
+            points: vec![
+                Point2::new(0.0, 0.0),
+                Point2::new(1.0, 0.0),
+                Point2::new(1.0, 1.0),
+                Point2::new(0.0, 1.0),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            boundary: vec![0, 1, 2, 3],
+            constrained_edges: vec![],
+        }
+    }
+
+    fn with_center(c: Point2<f64>) -> PlanarMesh {
+        let d = square();
+        let mut points = d.points.clone();
+        points.push(c);
+        PlanarMesh {
+            points,
+            triangles: vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]],
+            origin: vec![Some(0), Some(1), Some(2), Some(3), None],
+        }
+    }
+
+    #[test]
+    fn accepts_valid_remesh() -> Result<(), InvariantError> {
+        certify_planar(&square(), &with_center(Point2::new(0.3, 0.6)))
+    }
+
+    #[test]
+    fn rejects_moved_boundary_vertex() {
+        let mut m = with_center(Point2::new(0.5, 0.5));
+        m.points[2].x = 1.0 + f64::EPSILON;
+        let e = certify_planar(&square(), &m);
+        assert!(
+            matches!(e, Err(InvariantError::PlanarInvalid { reason }) if reason.contains("v2"))
+        );
+    }
+
+    #[test]
+    fn rejects_flipped_and_outside() {
+        // The center outside: some triangle turns clockwise.
+        let m = with_center(Point2::new(1.5, 0.5));
+        let e = certify_planar(&square(), &m);
+        assert!(
+            matches!(e, Err(InvariantError::PlanarInvalid { reason }) if reason.contains("non-positive"))
+        );
+        // The center on the boundary: a degenerate triangle.
+        let m = with_center(Point2::new(1.0, 0.5));
+        assert!(certify_planar(&square(), &m).is_err());
+    }
+
+    #[test]
+    fn rejects_missing_boundary_edge() {
+        // Triangles of another square order: boundary loop (0, 1, 3, 2) is not the input loop.
+        let mut m = with_center(Point2::new(0.5, 0.5));
+        m.triangles.pop();
+        let e = certify_planar(&square(), &m);
+        assert!(
+            matches!(e, Err(InvariantError::PlanarInvalid { reason }) if reason.contains("(v3, v0)"))
+        );
+    }
+
+    #[test]
+    fn point_in_polygon_is_exact() {
+        let sq = square().points;
+        assert_eq!(point_in_polygon(&sq, &Point2::new(0.5, 0.5)), Some(true));
+        assert_eq!(point_in_polygon(&sq, &Point2::new(1.0, 0.5)), None);
+        assert_eq!(point_in_polygon(&sq, &Point2::new(0.0, 0.0)), None);
+        assert_eq!(
+            point_in_polygon(&sq, &Point2::new(1.0 + f64::EPSILON, 0.5)),
+            Some(false)
+        );
+        assert_eq!(point_in_polygon(&sq, &Point2::new(0.5, 1.0)), None);
+        assert_eq!(point_in_polygon(&sq, &Point2::new(-0.5, 0.0)), Some(false));
+    }
+}

@@ -1,0 +1,738 @@
+//! The LCT planar remesher (Sec. 3.3, ref. [5]: Fu, Liu, Snyder, Guo 2014, "Anisotropic
+//! simplicial meshing using local convex functions").
+//!
+//! Energy (the local convex function energy of [5], written in paper-notes.md): every vertex
+//! `v` carries the convex function `f_v(x) = ½ (x − v)ᵀ M_v (x − v)`; the energy is the L1 error
+//! of its piecewise-linear interpolation, summed over vertices and their 1-rings, which on one
+//! triangle `T` (Euclidean area `|T|` in the parameter plane) is in closed form
+//!
+//! ```text
+//! E_T = |T| / 24 · Σ_{v ∈ T} Σ_{edges e of T} eᵀ M_v e  =  |T| / 8 · Σ_e eᵀ M̄_T e,
+//! ```
+//!
+//! with `M̄_T` the mean of the three vertex tensors. The three steps the paper names are applied in
+//! a fixed schedule (see [`LctOptions`]): edge length adjustment (split / collapse), connectivity
+//! update (energy-decreasing flips of convex quads) and vertex position optimisation (Newton on
+//! the 1-ring energy, backtracked so that every 1-ring triangle stays positive by exact
+//! `orient2d`). Boundary and constrained vertices and edges never change.
+
+use super::{clamp_spd, Metric2d, PlanarDomain, PlanarMesh, PlanarRemesher, Remesh2dError};
+use crate::invariants::certify_planar;
+use crate::predicates::{orient2d, Sign};
+use nalgebra::{Matrix2, Point2, Vector2};
+use rand::seq::SliceRandom;
+use rand_chacha::ChaCha8Rng;
+use std::collections::{HashMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// Options of the LCT remesher, with their defaults.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LctOptions {
+    /// Outer rounds of the schedule (default 8). One round: split passes, collapse passes,
+    /// flips, then `smoothing_iters` × (smoothing, flips).
+    pub rounds: usize,
+    /// Split interior edges whose metric length exceeds `split_ratio · L` (default 4/3).
+    pub split_ratio: f64,
+    /// Collapse interior edges whose metric length is below `collapse_ratio · L` (default 4/5).
+    pub collapse_ratio: f64,
+    /// Smoothing passes per round, each followed by flips (default 3).
+    pub smoothing_iters: usize,
+    /// Maximum split passes and collapse passes per round (default 6 each).
+    pub max_passes: usize,
+    /// Newton steps per vertex and smoothing pass (default 2).
+    pub newton_steps: usize,
+    /// Extra smoothing + flip passes after the last round (default 4).
+    pub final_smoothing: usize,
+    /// Run [`certify_planar`] after every round, not only at the end (default true).
+    pub certify_every_round: bool,
+}
+
+impl Default for LctOptions {
+    fn default() -> Self {
+        LctOptions {
+            rounds: 8,
+            split_ratio: 4.0 / 3.0,
+            collapse_ratio: 4.0 / 5.0,
+            smoothing_iters: 3,
+            max_passes: 6,
+            newton_steps: 2,
+            final_smoothing: 4,
+            certify_every_round: true,
+        }
+    }
+}
+
+/// The paper's planar remesher (default [`PlanarRemesher`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Lct {
+    /// Options.
+    pub options: LctOptions,
+}
+
+impl PlanarRemesher for Lct {
+    fn name(&self) -> &'static str {
+        "lct"
+    }
+
+    fn remesh(
+        &self,
+        domain: &PlanarDomain,
+        metric: &dyn Metric2d,
+        target_length: f64,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<PlanarMesh, Remesh2dError> {
+        remesh_planar(domain, metric, target_length, &self.options, rng)
+    }
+}
+
+/// The identity remesh of `domain` (every vertex its own origin).
+fn identity(domain: &PlanarDomain) -> PlanarMesh {
+    PlanarMesh {
+        points: domain.points.clone(),
+        triangles: domain.triangles.clone(),
+        origin: (0..domain.points.len() as u32).map(Some).collect(),
+    }
+}
+
+/// Remesh `domain` with LCT so that edges have metric length close to `target_length`
+/// (Sec. 3.3). The input is certified first ([`certify_planar`] of the identity remesh,
+/// failure → [`Remesh2dError::InvalidDomain`]); the output after every round (if
+/// `options.certify_every_round`) and at the end (failure → [`Remesh2dError::Invariant`]).
+pub fn remesh_planar(
+    domain: &PlanarDomain,
+    metric: &dyn Metric2d,
+    target_length: f64,
+    options: &LctOptions,
+    rng: &mut ChaCha8Rng,
+) -> Result<PlanarMesh, Remesh2dError> {
+    if !(target_length.is_finite() && target_length > 0.0) {
+        return Err(Remesh2dError::InvalidDomain(format!(
+            "target length {target_length} is not positive"
+        )));
+    }
+    certify_planar(domain, &identity(domain))
+        .map_err(|e| Remesh2dError::InvalidDomain(e.to_string()))?;
+    let mut fixed = vec![false; domain.points.len()];
+    for &b in &domain.boundary {
+        fixed[b as usize] = true;
+    }
+    let mut locked: HashSet<(u32, u32)> = HashSet::new();
+    let nb = domain.boundary.len();
+    for k in 0..nb {
+        let (a, b) = (domain.boundary[k], domain.boundary[(k + 1) % nb]);
+        locked.insert((a.min(b), a.max(b)));
+    }
+    for &[a, b] in &domain.constrained_edges {
+        fixed[a as usize] = true;
+        fixed[b as usize] = true;
+        locked.insert((a.min(b), a.max(b)));
+    }
+    let mut mesh = identity(domain);
+    // Fixed/locked status travels with `origin` (input ids) across rounds.
+    for round in 0..=options.rounds {
+        let mut w = Work::new(&mesh, metric, target_length, &fixed, &locked, options)?;
+        if round < options.rounds {
+            for _ in 0..options.max_passes {
+                if w.split_pass() == 0 {
+                    break;
+                }
+            }
+            for _ in 0..options.max_passes {
+                if w.collapse_pass() == 0 {
+                    break;
+                }
+            }
+            w.flip_all();
+            for _ in 0..options.smoothing_iters {
+                w.smooth_pass(options, rng)?;
+                w.flip_all();
+            }
+        } else {
+            for _ in 0..options.final_smoothing {
+                w.smooth_pass(options, rng)?;
+                w.flip_all();
+            }
+        }
+        mesh = w.finish();
+        if options.certify_every_round || round == options.rounds {
+            certify_planar(domain, &mesh)?;
+        }
+    }
+    Ok(mesh)
+}
+
+/// A fast hasher for the packed `u64` half-edge keys (multiplicative, Fx-style).
+#[derive(Default)]
+struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(5) ^ b as u64).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+type KeyMap = HashMap<u64, u32, BuildHasherDefault<KeyHasher>>;
+
+#[inline]
+fn key(a: u32, b: u32) -> u64 {
+    ((a as u64) << 32) | b as u64
+}
+
+/// The triangle energy `|T|/8 · Σ_e eᵀ M̄ e` (module doc); `|T|` signed.
+#[inline]
+fn tri_energy(p: [Point2<f64>; 3], m: &Matrix2<f64>) -> f64 {
+    let area = 0.5 * (p[1] - p[0]).perp(&(p[2] - p[0]));
+    let s: f64 = (0..3)
+        .map(|i| {
+            let e = p[(i + 1) % 3] - p[i];
+            e.dot(&(m * e))
+        })
+        .sum();
+    area * s / 8.0
+}
+
+/// The working triangulation of one round: a triangle list with a half-edge map.
+struct Work<'a> {
+    pts: Vec<Point2<f64>>,
+    origin: Vec<Option<u32>>,
+    vm: Vec<Matrix2<f64>>,
+    fixed: Vec<bool>,
+    valive: Vec<bool>,
+    tris: Vec<[u32; 3]>,
+    alive: Vec<bool>,
+    touched: Vec<bool>,
+    he: KeyMap,
+    vt: Vec<u32>,
+    locked: HashSet<(u32, u32)>,
+    metric: &'a dyn Metric2d,
+    l: f64,
+    split: f64,
+    collapse: f64,
+}
+
+impl<'a> Work<'a> {
+    fn new(
+        mesh: &PlanarMesh,
+        metric: &'a dyn Metric2d,
+        l: f64,
+        fixed_in: &[bool],
+        locked_in: &HashSet<(u32, u32)>,
+        options: &LctOptions,
+    ) -> Result<Self, Remesh2dError> {
+        let n = mesh.points.len();
+        let mut inv: HashMap<u32, u32> = HashMap::new();
+        let mut fixed = vec![false; n];
+        for (i, o) in mesh.origin.iter().enumerate() {
+            if let Some(j) = *o {
+                inv.insert(j, i as u32);
+                fixed[i] = fixed_in[j as usize];
+            }
+        }
+        let locked = locked_in
+            .iter()
+            .filter_map(|(a, b)| {
+                let (x, y) = (*inv.get(a)?, *inv.get(b)?);
+                Some((x.min(y), x.max(y)))
+            })
+            .collect();
+        let vm = mesh
+            .points
+            .iter()
+            .map(|p| eval(metric, p))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut w = Work {
+            pts: mesh.points.clone(),
+            origin: mesh.origin.clone(),
+            vm,
+            fixed,
+            valive: vec![true; n],
+            tris: Vec::with_capacity(mesh.triangles.len() * 2),
+            alive: Vec::new(),
+            touched: Vec::new(),
+            he: KeyMap::default(),
+            vt: vec![u32::MAX; n],
+            locked,
+            metric,
+            l,
+            split: options.split_ratio,
+            collapse: options.collapse_ratio,
+        };
+        w.he.reserve(mesh.triangles.len() * 6);
+        for t in &mesh.triangles {
+            w.add_tri(*t);
+        }
+        Ok(w)
+    }
+
+    fn add_tri(&mut self, t: [u32; 3]) -> u32 {
+        let i = self.tris.len() as u32;
+        self.tris.push(t);
+        self.alive.push(true);
+        self.touched.push(false);
+        for k in 0..3 {
+            self.he.insert(key(t[k], t[(k + 1) % 3]), i);
+            self.vt[t[k] as usize] = i;
+        }
+        i
+    }
+
+    fn remove_tri(&mut self, i: u32) {
+        let t = self.tris[i as usize];
+        self.alive[i as usize] = false;
+        for k in 0..3 {
+            let kk = key(t[k], t[(k + 1) % 3]);
+            if self.he.get(&kk) == Some(&i) {
+                self.he.remove(&kk);
+            }
+        }
+    }
+
+    /// Replace triangle `i` in place (used by flips).
+    fn set_tri(&mut self, i: u32, t: [u32; 3]) {
+        self.remove_tri(i);
+        self.alive[i as usize] = true;
+        self.tris[i as usize] = t;
+        for k in 0..3 {
+            self.he.insert(key(t[k], t[(k + 1) % 3]), i);
+            self.vt[t[k] as usize] = i;
+        }
+    }
+
+    fn add_vertex(&mut self, p: Point2<f64>) -> Result<u32, Remesh2dError> {
+        let m = eval(self.metric, &p)?;
+        self.pts.push(p);
+        self.origin.push(None);
+        self.vm.push(m);
+        self.fixed.push(false);
+        self.valive.push(true);
+        self.vt.push(u32::MAX);
+        Ok(self.pts.len() as u32 - 1)
+    }
+
+    /// Triangle `t` rotated so that `v` comes first.
+    fn rotated(&self, t: u32, v: u32) -> [u32; 3] {
+        let x = self.tris[t as usize];
+        if x[0] == v {
+            x
+        } else if x[1] == v {
+            [x[1], x[2], x[0]]
+        } else {
+            [x[2], x[0], x[1]]
+        }
+    }
+
+    /// The triangles around `v`, counter-clockwise (for a boundary vertex: from one boundary
+    /// edge to the other). `None` if the vertex's star is inconsistent.
+    fn star(&self, v: u32) -> Option<Vec<u32>> {
+        let t0 = self.vt[v as usize];
+        if t0 == u32::MAX || !self.alive[t0 as usize] || !self.tris[t0 as usize].contains(&v) {
+            return None;
+        }
+        let mut out = vec![t0];
+        let mut t = t0;
+        loop {
+            let [_, _, c] = self.rotated(t, v);
+            match self.he.get(&key(v, c)) {
+                Some(&nt) if nt == t0 => return Some(out),
+                Some(&nt) => {
+                    if out.len() > 64 {
+                        return None;
+                    }
+                    out.push(nt);
+                    t = nt;
+                }
+                None => break,
+            }
+        }
+        // Open star: walk clockwise from t0 too.
+        let mut back = Vec::new();
+        let mut t = t0;
+        loop {
+            let [_, b, _] = self.rotated(t, v);
+            match self.he.get(&key(b, v)) {
+                Some(&pt) => {
+                    if back.len() > 64 {
+                        return None;
+                    }
+                    back.push(pt);
+                    t = pt;
+                }
+                None => break,
+            }
+        }
+        back.reverse();
+        back.extend(out);
+        Some(back)
+    }
+
+    fn edge_len(&self, a: u32, b: u32) -> f64 {
+        let e = self.pts[b as usize] - self.pts[a as usize];
+        let m = (self.vm[a as usize] + self.vm[b as usize]) * 0.5;
+        e.dot(&(m * e)).max(0.0).sqrt()
+    }
+
+    fn is_locked(&self, a: u32, b: u32) -> bool {
+        self.locked.contains(&(a.min(b), a.max(b)))
+    }
+
+    fn positive(&self, t: [u32; 3]) -> bool {
+        orient2d(
+            &self.pts[t[0] as usize],
+            &self.pts[t[1] as usize],
+            &self.pts[t[2] as usize],
+        ) == Sign::Positive
+    }
+
+    fn energy(&self, t: [u32; 3]) -> f64 {
+        let m = (self.vm[t[0] as usize] + self.vm[t[1] as usize] + self.vm[t[2] as usize]) / 3.0;
+        tri_energy(t.map(|i| self.pts[i as usize]), &m)
+    }
+
+    /// Interior, unlocked edges `(a, b)` with `a < b` and their metric lengths, filtered by
+    /// `keep(len)`, sorted by `order` of length then by key (deterministic).
+    fn edges_where(&self, keep: impl Fn(f64) -> bool, longest_first: bool) -> Vec<(f64, u32, u32)> {
+        let mut v = Vec::new();
+        for (i, t) in self.tris.iter().enumerate() {
+            if !self.alive[i] {
+                continue;
+            }
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if a < b && self.he.contains_key(&key(b, a)) && !self.is_locked(a, b) {
+                    let l = self.edge_len(a, b);
+                    if keep(l) {
+                        v.push((l, a, b));
+                    }
+                }
+            }
+        }
+        v.sort_by(|x, y| {
+            let o = x.0.total_cmp(&y.0);
+            let o = if longest_first { o.reverse() } else { o };
+            o.then((x.1, x.2).cmp(&(y.1, y.2)))
+        });
+        v
+    }
+
+    fn clear_touched(&mut self) {
+        self.touched.iter_mut().for_each(|t| *t = false);
+    }
+
+    /// Edge length adjustment, part 1: split every (non-adjacent) long interior edge at its
+    /// midpoint. Returns the number of splits.
+    fn split_pass(&mut self) -> usize {
+        self.clear_touched();
+        let thr = self.split * self.l;
+        let cands = self.edges_where(|l| l > thr, true);
+        let mut n = 0;
+        for (_, a, b) in cands {
+            let (Some(&t1), Some(&t2)) = (self.he.get(&key(a, b)), self.he.get(&key(b, a))) else {
+                continue;
+            };
+            if self.touched[t1 as usize] || self.touched[t2 as usize] {
+                continue;
+            }
+            let c = self.rotated(t1, a)[2];
+            let d = self.rotated(t2, b)[2];
+            let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
+            let m = Point2::new(0.5 * (pa.x + pb.x), 0.5 * (pa.y + pb.y));
+            // Rounding can put the midpoint off the segment: check all four new triangles.
+            let ok = orient2d(&pa, &m, &self.pts[c as usize]) == Sign::Positive
+                && orient2d(&m, &pb, &self.pts[c as usize]) == Sign::Positive
+                && orient2d(&pb, &m, &self.pts[d as usize]) == Sign::Positive
+                && orient2d(&m, &pa, &self.pts[d as usize]) == Sign::Positive;
+            if !ok {
+                continue;
+            }
+            let Ok(mi) = self.add_vertex(m) else { continue };
+            self.remove_tri(t1);
+            self.remove_tri(t2);
+            for t in [[a, mi, c], [mi, b, c], [b, mi, d], [mi, a, d]] {
+                let i = self.add_tri(t);
+                self.touched[i as usize] = true;
+            }
+            n += 1;
+        }
+        n
+    }
+
+    /// Edge length adjustment, part 2: collapse short interior edges onto one endpoint (the
+    /// removed endpoint must be free). Refused when the link condition fails, when a
+    /// remaining triangle would not be positive (exact), or when a new edge would be longer
+    /// than the split threshold. Returns the number of collapses.
+    fn collapse_pass(&mut self) -> usize {
+        self.clear_touched();
+        let thr = self.collapse * self.l;
+        let cands = self.edges_where(|l| l < thr, false);
+        let mut n = 0;
+        for (_, a, b) in cands {
+            if !self.valive[a as usize] || !self.valive[b as usize] {
+                continue;
+            }
+            if self.try_collapse(a, b) || self.try_collapse(b, a) {
+                n += 1;
+            }
+        }
+        n
+    }
+
+    /// Collapse `a` onto `b` (remove `a`).
+    fn try_collapse(&mut self, a: u32, b: u32) -> bool {
+        if self.fixed[a as usize] {
+            return false;
+        }
+        let (Some(&t1), Some(&t2)) = (self.he.get(&key(a, b)), self.he.get(&key(b, a))) else {
+            return false;
+        };
+        let Some(star_a) = self.star(a) else {
+            return false;
+        };
+        let Some(star_b) = self.star(b) else {
+            return false;
+        };
+        if star_a.iter().any(|&t| self.touched[t as usize]) {
+            return false;
+        }
+        let c = self.rotated(t1, a)[2];
+        let d = self.rotated(t2, b)[2];
+        // Link condition: the common neighbours of a and b are exactly c and d.
+        let ring = |s: &[u32], v: u32| -> Vec<u32> {
+            let mut r: Vec<u32> = s
+                .iter()
+                .flat_map(|&t| self.tris[t as usize])
+                .filter(|&x| x != v)
+                .collect();
+            r.sort_unstable();
+            r.dedup();
+            r
+        };
+        let ra = ring(&star_a, a);
+        let rb = ring(&star_b, b);
+        let common: Vec<u32> = ra
+            .iter()
+            .filter(|x| rb.binary_search(x).is_ok())
+            .copied()
+            .collect();
+        let mut cd = [c, d];
+        cd.sort_unstable();
+        if common != cd {
+            return false;
+        }
+        let limit = self.split * self.l;
+        let mut new_tris = Vec::with_capacity(star_a.len());
+        for &t in &star_a {
+            if t == t1 || t == t2 {
+                continue;
+            }
+            let nt = self.tris[t as usize].map(|x| if x == a { b } else { x });
+            if !self.positive(nt) {
+                return false;
+            }
+            new_tris.push(nt);
+        }
+        // The removed vertex's metric stays out of the new edges: measure with b's.
+        let pb = self.pts[b as usize];
+        for &x in &ra {
+            if x != b {
+                let e = self.pts[x as usize] - pb;
+                let m = (self.vm[x as usize] + self.vm[b as usize]) * 0.5;
+                if e.dot(&(m * e)).sqrt() > limit {
+                    return false;
+                }
+            }
+        }
+        for &t in &star_a {
+            self.remove_tri(t);
+        }
+        for nt in new_tris {
+            let i = self.add_tri(nt);
+            self.touched[i as usize] = true;
+        }
+        self.valive[a as usize] = false;
+        true
+    }
+
+    /// Connectivity update: flip interior unlocked edges of strictly convex quads (exact
+    /// `orient2d`) when the LCT energy strictly decreases, until no flip applies. Each flip
+    /// lowers the total energy, so this ends; a cap of 20 flips per triangle guards anyway.
+    fn flip_all(&mut self) -> usize {
+        let mut queue: Vec<(u32, u32)> = Vec::new();
+        for (i, t) in self.tris.iter().enumerate() {
+            if self.alive[i] {
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    if a < b {
+                        queue.push((a, b));
+                    }
+                }
+            }
+        }
+        let cap = 20 * self.tris.len();
+        let mut n = 0;
+        while let Some((a, b)) = queue.pop() {
+            if n >= cap {
+                break;
+            }
+            if self.is_locked(a, b) {
+                continue;
+            }
+            let (Some(&t1), Some(&t2)) = (self.he.get(&key(a, b)), self.he.get(&key(b, a))) else {
+                continue;
+            };
+            let c = self.rotated(t1, a)[2];
+            let d = self.rotated(t2, b)[2];
+            if c == d || self.he.contains_key(&key(c, d)) || self.he.contains_key(&key(d, c)) {
+                continue;
+            }
+            let (n1, n2) = ([a, d, c], [d, b, c]);
+            if !self.positive(n1) || !self.positive(n2) {
+                continue;
+            }
+            let old = self.energy([a, b, c]) + self.energy([b, a, d]);
+            let new = self.energy(n1) + self.energy(n2);
+            if !(new < old * (1.0 - 1e-10)) {
+                continue;
+            }
+            self.set_tri(t1, n1);
+            self.set_tri(t2, n2);
+            n += 1;
+            for (x, y) in [(a, d), (d, b), (b, c), (c, a)] {
+                queue.push((x.min(y), x.max(y)));
+            }
+        }
+        n
+    }
+
+    /// Vertex position optimisation: every free vertex, in a seeded random order, moves to
+    /// the minimiser of its 1-ring energy `Σ_T E_T(x)` (tensors frozen at the current
+    /// positions): Newton steps on the cubic `E_T = A_T(x)·S_T(x)/8`, with the positive
+    /// "frozen area" Hessian `Σ 4 A_T M̄_T` when the true one is not positive definite; each
+    /// step halves until the energy decreases and every 1-ring triangle is positive (exact).
+    fn smooth_pass(
+        &mut self,
+        options: &LctOptions,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<(), Remesh2dError> {
+        let mut order: Vec<u32> = (0..self.pts.len() as u32)
+            .filter(|&v| self.valive[v as usize] && !self.fixed[v as usize])
+            .collect();
+        order.shuffle(rng);
+        for v in order {
+            let Some(star) = self.star(v) else { continue };
+            // Closed star only (free vertices are interior).
+            let ring: Vec<[u32; 3]> = star.iter().map(|&t| self.rotated(t, v)).collect();
+            if ring.windows(2).any(|w| w[0][2] != w[1][1]) {
+                continue;
+            }
+            let mv = self.vm[v as usize];
+            let tens: Vec<(Point2<f64>, Point2<f64>, Matrix2<f64>)> = ring
+                .iter()
+                .map(|t| {
+                    (
+                        self.pts[t[1] as usize],
+                        self.pts[t[2] as usize],
+                        (mv + self.vm[t[1] as usize] + self.vm[t[2] as usize]) / 3.0,
+                    )
+                })
+                .collect();
+            let energy = |x: &Point2<f64>| -> f64 {
+                tens.iter()
+                    .map(|(p, q, m)| tri_energy([*x, *p, *q], m))
+                    .sum()
+            };
+            let x0 = self.pts[v as usize];
+            let mut x = x0;
+            let mut e = energy(&x);
+            for _ in 0..options.newton_steps {
+                let mut g = Vector2::zeros();
+                let mut h = Matrix2::zeros();
+                let mut h0 = Matrix2::zeros();
+                for (p, q, m) in &tens {
+                    let area = 0.5 * (p - x).perp(&(q - x));
+                    let ga = 0.5 * Vector2::new(p.y - q.y, q.x - p.x);
+                    let (ep, eq) = (x - p, x - q);
+                    let s = ep.dot(&(m * ep)) + eq.dot(&(m * eq)) + (p - q).dot(&(m * (p - q)));
+                    let gs = 2.0 * m * (ep + eq);
+                    g += (area * gs + s * ga) / 8.0;
+                    h += (4.0 * area * m + ga * gs.transpose() + gs * ga.transpose()) / 8.0;
+                    h0 += 4.0 * area.abs() * m / 8.0;
+                }
+                let pd = h.determinant() > 0.0 && h.trace() > 0.0;
+                let step = if pd { h.try_inverse() } else { None }
+                    .or_else(|| h0.try_inverse())
+                    .map(|hi| -(hi * g));
+                let Some(step) = step else { break };
+                if !step.iter().all(|s| s.is_finite()) {
+                    break;
+                }
+                let mut t = 1.0;
+                let mut moved = false;
+                for _ in 0..12 {
+                    let xn = x + step * t;
+                    let ok = tens
+                        .iter()
+                        .all(|(p, q, _)| orient2d(&xn, p, q) == Sign::Positive);
+                    if ok {
+                        let en = energy(&xn);
+                        if en < e {
+                            x = xn;
+                            e = en;
+                            moved = true;
+                            break;
+                        }
+                    }
+                    t *= 0.5;
+                }
+                if !moved {
+                    break;
+                }
+            }
+            if x != x0 {
+                self.pts[v as usize] = x;
+                self.vm[v as usize] = eval(self.metric, &x)?;
+                self.origin[v as usize] = None;
+            }
+        }
+        Ok(())
+    }
+
+    /// The compacted mesh.
+    fn finish(self) -> PlanarMesh {
+        let mut map = vec![u32::MAX; self.pts.len()];
+        let mut points = Vec::new();
+        let mut origin = Vec::new();
+        let mut triangles = Vec::new();
+        for (i, t) in self.tris.iter().enumerate() {
+            if !self.alive[i] {
+                continue;
+            }
+            let nt = t.map(|v| {
+                if map[v as usize] == u32::MAX {
+                    map[v as usize] = points.len() as u32;
+                    points.push(self.pts[v as usize]);
+                    origin.push(self.origin[v as usize]);
+                }
+                map[v as usize]
+            });
+            triangles.push(nt);
+        }
+        PlanarMesh {
+            points,
+            triangles,
+            origin,
+        }
+    }
+}
+
+/// Evaluate the metric, clamped to SPD ([`clamp_spd`]).
+fn eval(metric: &dyn Metric2d, p: &Point2<f64>) -> Result<Matrix2<f64>, Remesh2dError> {
+    clamp_spd(&metric.metric(p)).ok_or(Remesh2dError::MetricNotSpd { x: p.x, y: p.y })
+}
