@@ -1,16 +1,660 @@
 //! Algorithm 1: the loop over patches.
+//!
+//! ```text
+//! while an unprocessed face remains:
+//!     P  = strategy.next_patch(working mesh, processed, rng)       // Sec. 3.2  (certify_disk)
+//!     uv = parameterizer.parameterize(P)                            // Sec. 3.3  (certify_bijective)
+//!     M2 = transfer_metric(P, uv, M at the reference locations)     // Eq. 4
+//!     P' = remesher.remesh(uv domain, M2, L_tar)                     // LCT       (certify_planar)
+//!     lift P' by barycentric location in the initial 2D mesh and
+//!         project onto the reference surface                         // "Mapping back"
+//!     certify the candidate (no degenerate or flipped new face)
+//!     stitch P' into the working mesh, mark its faces processed     // manifold, oriented,
+//!                                                                    // same topology, boundary
+//! at the end: no self-intersections (exact)
+//! ```
+//!
+//! Everything runs in the unit-diagonal space of the metric field's reference mesh
+//! (`crate::metric::Normalization`); the caller maps the result back to file units.
 
+use crate::ids::{EdgeKey, FaceId, PatchId, VertexId};
+use crate::invariants::{self, InvariantError, Offenders};
+use crate::lift::{lift, PatchFrame};
+use crate::mesh::{SurfaceLocation, Topology, TriMesh};
+use crate::metric::MetricField;
+use crate::param::{DistortionReport, Parameterizer, SymmetricDirichlet};
+use crate::patches::{extract_patch, ConePatches, PatchContext, PatchStrategy};
+use crate::remesh2d::{
+    transfer_metric, Lct, PlanarDomain, PlanarMetricField, PlanarRemesher, TransferMethod,
+};
+use crate::stitch::{stitch, Replacement, WorkingMesh};
+use nalgebra::Matrix3;
+use rand::SeedableRng;
+use serde::Serialize;
+use std::collections::HashSet;
+use std::path::PathBuf;
+use std::time::Instant;
 use thiserror::Error;
 
-/// Errors of Algorithm 1.
+/// Errors of Algorithm 1. Every variant names the patch, its seed and the offending elements.
 #[derive(Debug, Error)]
 pub enum PipelineError {
     /// A stage failed on a patch.
-    #[error("patch {patch}: {message}")]
+    #[error("patch {patch} (seed {seed}): {stage} failed: {message}")]
     Stage {
         /// which patch
-        patch: crate::ids::PatchId,
+        patch: PatchId,
+        /// its seed vertex
+        seed: VertexId,
+        /// which stage
+        stage: &'static str,
         /// what failed
         message: String,
     },
+    /// A certificate on the working mesh failed after a patch was stitched.
+    #[error("after patch {patch} (seed {seed}): {source}{}", debug_note(.debug_file))]
+    Certificate {
+        /// which patch (`p0` before the first one)
+        patch: PatchId,
+        /// its seed vertex
+        seed: VertexId,
+        /// the violated invariant, naming the elements
+        source: InvariantError,
+        /// where the offending patch was written
+        debug_file: Option<PathBuf>,
+    },
+    /// The final mesh self-intersects.
+    #[error("final mesh: {0}")]
+    Final(InvariantError),
+    /// The strategy returned a patch without an unprocessed face (the loop would not end).
+    #[error("patch {patch} (seed {seed}) contains no unprocessed face; the strategy must make progress")]
+    NoProgress {
+        /// which patch
+        patch: PatchId,
+        /// its seed
+        seed: VertexId,
+    },
+    /// The patch budget ran out.
+    #[error("stopped after {0} patches (--max-patches) with {1} faces unprocessed")]
+    Budget(usize, usize),
+    /// Invalid input or options.
+    #[error("{0}")]
+    Input(String),
+}
+
+fn debug_note(p: &Option<PathBuf>) -> String {
+    match p {
+        Some(p) => format!(" (offending patch written to {})", p.display()),
+        None => String::new(),
+    }
+}
+
+pub use crate::quality::TargetLength;
+
+/// Options of Algorithm 1.
+#[derive(Clone, Debug, Serialize)]
+pub struct RemeshOptions {
+    /// Seed of the one RNG every stage draws from.
+    pub seed: u64,
+    /// Target metric edge length.
+    pub target: TargetLength,
+    /// How the 3D metric is carried to the plane (Eq. 4 by default).
+    #[serde(skip)]
+    pub transfer: TransferMethod,
+    /// Run the exact self-intersection test on the final mesh.
+    pub check_self_intersections: bool,
+    /// Where offending patches are written when a certificate fails.
+    pub debug_dir: Option<PathBuf>,
+    /// Stop after this many patches (error), to bound runaway runs.
+    pub max_patches: Option<usize>,
+}
+
+impl Default for RemeshOptions {
+    fn default() -> Self {
+        RemeshOptions {
+            seed: 1,
+            target: TargetLength::Factor(1.5),
+            transfer: TransferMethod::Eq4PrincipalFit,
+            check_self_intersections: true,
+            debug_dir: None,
+            max_patches: None,
+        }
+    }
+}
+
+/// The research extension points, with the paper's methods as defaults.
+pub struct Stages {
+    /// Sec. 3.2.
+    pub patches: Box<dyn PatchStrategy>,
+    /// Sec. 3.3, embedding.
+    pub parameterizer: Box<dyn Parameterizer>,
+    /// Sec. 3.3, planar remeshing.
+    pub remesher: Box<dyn PlanarRemesher>,
+}
+
+impl Default for Stages {
+    fn default() -> Self {
+        Stages {
+            patches: Box::new(ConePatches::default()),
+            parameterizer: Box::new(SymmetricDirichlet::default()),
+            remesher: Box::new(Lct::default()),
+        }
+    }
+}
+
+/// Wall time per stage, seconds.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StageTimes {
+    /// Patch generation and certify_disk.
+    pub patches: f64,
+    /// Parameterization (includes its certificate).
+    pub param: f64,
+    /// Metric transfer.
+    pub transfer: f64,
+    /// Planar remeshing (includes its certificate).
+    pub remesh2d: f64,
+    /// Lifting and projection.
+    pub lift: f64,
+    /// Stitching.
+    pub stitch: f64,
+    /// Working-mesh certificates after every patch.
+    pub certify: f64,
+    /// Final self-intersection test.
+    pub final_check: f64,
+}
+
+/// How many times each certificate was checked and held. A run that returns `Ok` has every
+/// count equal to the number of patches (or 1 for the final ones).
+#[derive(Clone, Debug, Default, Serialize, PartialEq, Eq)]
+pub struct Certificate {
+    /// Patches certified to be topological disks.
+    pub disk: usize,
+    /// Parameterizations certified bijective (exact orient2d, simple boundary).
+    pub bijective: usize,
+    /// Planar remeshes certified (positive, same boundary, disk).
+    pub planar: usize,
+    /// Working mesh edge- and vertex-manifold after the patch.
+    pub manifold: usize,
+    /// Working mesh consistently oriented after the patch.
+    pub oriented: usize,
+    /// Genus, components and boundary loops equal the input's after the patch.
+    pub same_topology: usize,
+    /// The input's boundary vertices and edges unchanged after the patch.
+    pub boundary_preserved: usize,
+    /// No new face degenerate (exact) after the patch.
+    pub no_degenerate: usize,
+    /// No new face flipped against the reference after the patch.
+    pub no_flips: usize,
+    /// Final mesh free of self-intersections (exact), 0 if not checked.
+    pub no_self_intersections: usize,
+    /// Patches whose parameterizer fell back to its last certified iterate.
+    pub param_fallbacks: usize,
+}
+
+/// Per-patch record.
+#[derive(Clone, Debug, Serialize)]
+pub struct PatchRecord {
+    /// Patch id.
+    pub id: u32,
+    /// Seed vertex (working-mesh id at the time).
+    pub seed: u32,
+    /// Faces replaced.
+    pub faces_in: usize,
+    /// Of which unprocessed before.
+    pub unprocessed_in: usize,
+    /// Faces produced.
+    pub faces_out: usize,
+    /// Cone angle in degrees, if the strategy fits one.
+    pub cone_angle_deg: Option<f64>,
+    /// Distortion of its parameterization.
+    pub distortion: DistortionReport,
+}
+
+/// The outcome of Algorithm 1.
+#[derive(Clone, Debug)]
+pub struct RemeshResult {
+    /// The remeshed surface (unit-diagonal space, compacted).
+    pub mesh: TriMesh,
+    /// Reference location of every output vertex.
+    pub locations: Vec<SurfaceLocation>,
+    /// What was done and certified.
+    pub report: RemeshReport,
+}
+
+/// The report of a run (serialised into `--report`).
+#[derive(Clone, Debug, Serialize)]
+pub struct RemeshReport {
+    /// Options used.
+    pub options: RemeshOptions,
+    /// Strategy / parameterizer / remesher names.
+    pub stages: [String; 3],
+    /// Mean metric edge length of the input (L_avg).
+    pub l_avg: f64,
+    /// Target metric edge length (L_tar).
+    pub l_tar: f64,
+    /// Number of patches.
+    pub patches: usize,
+    /// Per-stage times.
+    pub times: StageTimes,
+    /// Certificates.
+    pub certificate: Certificate,
+    /// Per-patch records.
+    pub patch_records: Vec<PatchRecord>,
+    /// Input and output sizes.
+    pub faces_in: usize,
+    /// Output faces.
+    pub faces_out: usize,
+    /// Output vertices.
+    pub vertices_out: usize,
+}
+
+/// Progress reported after every patch.
+#[derive(Copy, Clone, Debug)]
+pub struct Progress {
+    /// Patches done.
+    pub patches: usize,
+    /// Input faces covered so far (processed fraction of the working mesh).
+    pub unprocessed: usize,
+    /// Faces at the start.
+    pub total: usize,
+}
+
+/// Topological signature compared after every patch: per component (faces-independent)
+/// genus and boundary loops, sorted, plus the component count.
+fn topology_signature(topo: &Topology) -> Vec<(Option<u32>, usize)> {
+    let mut s: Vec<_> = topo
+        .components()
+        .iter()
+        .map(|c| (c.genus, c.boundary_loops))
+        .collect();
+    s.sort();
+    s
+}
+
+/// Run Algorithm 1 on the metric field's reference mesh.
+///
+/// Randomness: one ChaCha8 stream seeded with `options.seed`, drawn only by the patch
+/// strategy and the planar remesher, in patch order, so the output depends on the seed only
+/// (not on thread count).
+pub fn remesh(
+    field: &MetricField,
+    stages: &Stages,
+    options: &RemeshOptions,
+    mut on_progress: impl FnMut(Progress),
+) -> Result<RemeshResult, PipelineError> {
+    let reference = field.reference();
+    if reference.n_faces() == 0 {
+        return Err(PipelineError::Input("the input mesh has no faces".into()));
+    }
+    let l_avg = crate::quality::edge_length_average(reference, field.vertex_metrics());
+    let l_tar = match options.target {
+        TargetLength::Factor(f) => f * l_avg,
+        TargetLength::Absolute(l) => l,
+    };
+    if !(l_tar.is_finite() && l_tar > 0.0) {
+        return Err(PipelineError::Input(format!(
+            "target edge length {l_tar} is not a positive finite number (L_avg = {l_avg})"
+        )));
+    }
+    let mut rng = crate::Rng::seed_from_u64(options.seed);
+    let mut work = WorkingMesh::from_reference(reference);
+    let ref_topo = Topology::build(reference);
+    let signature = topology_signature(&ref_topo);
+    // The input's boundary edges, by vertex ids (input vertices are never renumbered during
+    // the loop and boundary vertices are never moved: the remesher keeps patch boundaries).
+    let input_boundary: Vec<EdgeKey> = ref_topo
+        .boundary_loops()
+        .iter()
+        .flat_map(|l| (0..l.len()).map(move |i| EdgeKey::new(l[i], l[(i + 1) % l.len()])))
+        .collect();
+    let total = work.mesh.n_faces();
+    let mut times = StageTimes::default();
+    let mut cert = Certificate::default();
+    let mut records = Vec::new();
+    let mut topo = ref_topo.clone();
+
+    let mut n_patch = 0usize;
+    loop {
+        if work.unprocessed() == 0 {
+            break;
+        }
+        if let Some(max) = options.max_patches {
+            if n_patch >= max {
+                return Err(PipelineError::Budget(n_patch, work.unprocessed()));
+            }
+        }
+        let pid = PatchId::new(n_patch);
+        // (a) next patch, certified a disk.
+        let t0 = Instant::now();
+        let ctx = PatchContext {
+            mesh: &work.mesh,
+            topology: &topo,
+            processed: &work.processed,
+            feature_edges: None,
+        };
+        let patch = match stages.patches.next_patch(&ctx, &mut rng) {
+            Ok(Some(p)) => p,
+            Ok(None) => break,
+            Err(e) => {
+                return Err(PipelineError::Stage {
+                    patch: pid,
+                    seed: VertexId(u32::MAX),
+                    stage: "patch generation",
+                    message: e.to_string(),
+                })
+            }
+        };
+        let seed = patch.seed_vertex;
+        let stage_err = |stage: &'static str, message: String| PipelineError::Stage {
+            patch: pid,
+            seed,
+            stage,
+            message,
+        };
+        let unprocessed_in = patch
+            .faces
+            .iter()
+            .filter(|f| !work.processed[f.idx()])
+            .count();
+        if unprocessed_in == 0 {
+            return Err(PipelineError::NoProgress { patch: pid, seed });
+        }
+        invariants::certify_disk(&work.mesh, &patch.faces).map_err(|e| {
+            PipelineError::Certificate {
+                patch: pid,
+                seed,
+                source: e,
+                debug_file: write_debug(options, pid, "patch", &work.mesh, &patch.faces),
+            }
+        })?;
+        cert.disk += 1;
+        let disk = extract_patch(&work.mesh, &patch.faces)
+            .map_err(|e| stage_err("patch extraction", e.to_string()))?;
+        times.patches += t0.elapsed().as_secs_f64();
+
+        // (b) bijective parameterization, certified (the parameterizer certifies; we check
+        // again because it is a research extension point).
+        let t0 = Instant::now();
+        let param = stages
+            .parameterizer
+            .parameterize(&disk.mesh, &disk.boundary)
+            .map_err(|e| stage_err("parameterization", e.to_string()))?;
+        invariants::certify_bijective(&param.uv, &disk.mesh.triangles, &disk.boundary).map_err(
+            |e| PipelineError::Certificate {
+                patch: pid,
+                seed,
+                source: e,
+                debug_file: write_debug(options, pid, "param", &work.mesh, &patch.faces),
+            },
+        )?;
+        cert.bijective += 1;
+        if param.report.fell_back {
+            cert.param_fallbacks += 1;
+        }
+        times.param += t0.elapsed().as_secs_f64();
+
+        // (c) metric transfer (Eq. 4): 3D metric read from the reference field at each patch
+        // vertex's reference location, carried to the plane.
+        let t0 = Instant::now();
+        let metrics3d: Vec<Matrix3<f64>> = disk
+            .to_global
+            .iter()
+            .map(|g| field.eval_at(&work.locations[g.idx()]))
+            .collect();
+        let metrics2d = transfer_metric(&disk.mesh, &param.uv, &metrics3d, options.transfer)
+            .map_err(|e| stage_err("metric transfer", e.to_string()))?;
+        let tris_u32: Vec<[u32; 3]> = disk
+            .mesh
+            .triangles
+            .iter()
+            .map(|t| [t[0].0, t[1].0, t[2].0])
+            .collect();
+        let planar_field = PlanarMetricField::new(param.uv.clone(), tris_u32.clone(), metrics2d)
+            .map_err(|e| stage_err("metric transfer", e.to_string()))?;
+        times.transfer += t0.elapsed().as_secs_f64();
+
+        // (d) planar remeshing with the patch boundary fixed, certified.
+        let t0 = Instant::now();
+        let domain = PlanarDomain {
+            points: param.uv.clone(),
+            triangles: tris_u32,
+            boundary: disk.boundary.iter().map(|v| v.0).collect(),
+            constrained_edges: Vec::new(),
+        };
+        let planar = stages
+            .remesher
+            .remesh(&domain, &planar_field, l_tar, &mut rng)
+            .map_err(|e| stage_err("planar remeshing", e.to_string()))?;
+        invariants::certify_planar(&domain, &planar).map_err(|e| PipelineError::Certificate {
+            patch: pid,
+            seed,
+            source: e,
+            debug_file: write_debug(options, pid, "remesh2d", &work.mesh, &patch.faces),
+        })?;
+        cert.planar += 1;
+        times.remesh2d += t0.elapsed().as_secs_f64();
+
+        // (e) map back: barycentric location in the initial 2D mesh, then onto the reference.
+        let t0 = Instant::now();
+        let frame = PatchFrame {
+            triangles: &disk.mesh.triangles,
+            positions: &disk.mesh.positions,
+            to_global: &disk.to_global,
+        };
+        let replacement = lift(
+            &planar,
+            &frame,
+            |p| planar_field.locate(p),
+            |p| field.project(p).0,
+            reference,
+        )
+        .map_err(|e| stage_err("mapping back", e.to_string()))?;
+        times.lift += t0.elapsed().as_secs_f64();
+
+        // (f) certify the candidate's new faces before touching the working mesh.
+        let t0 = Instant::now();
+        certify_replacement(field, &work, &replacement).map_err(|e| {
+            PipelineError::Certificate {
+                patch: pid,
+                seed,
+                source: e,
+                debug_file: write_debug(options, pid, "lift", &work.mesh, &patch.faces),
+            }
+        })?;
+        cert.no_degenerate += 1;
+        cert.no_flips += 1;
+        times.certify += t0.elapsed().as_secs_f64();
+
+        // (g) stitch and certify the working mesh.
+        let t0 = Instant::now();
+        let new_faces = stitch(&mut work, &patch.faces, &replacement)
+            .map_err(|e| stage_err("stitching", e.to_string()))?;
+        times.stitch += t0.elapsed().as_secs_f64();
+        let t0 = Instant::now();
+        topo = Topology::build(&work.mesh);
+        let fail = |e: InvariantError, work: &WorkingMesh| PipelineError::Certificate {
+            patch: pid,
+            seed,
+            source: e,
+            debug_file: write_debug(options, pid, "stitched", &work.mesh, &new_faces),
+        };
+        invariants::certify_manifold(&work.mesh, &topo).map_err(|e| fail(e, &work))?;
+        cert.manifold += 1;
+        invariants::certify_oriented(&work.mesh, &topo).map_err(|e| fail(e, &work))?;
+        cert.oriented += 1;
+        let sig = topology_signature(&topo);
+        if sig != signature {
+            return Err(fail(
+                InvariantError::TopologyChanged {
+                    what: "(genus, boundary loops) per component".into(),
+                    before: format!("{signature:?}"),
+                    after: format!("{sig:?}"),
+                },
+                &work,
+            ));
+        }
+        cert.same_topology += 1;
+        certify_input_boundary(&work.mesh, &topo, reference, &input_boundary)
+            .map_err(|e| fail(e, &work))?;
+        cert.boundary_preserved += 1;
+        times.certify += t0.elapsed().as_secs_f64();
+
+        records.push(PatchRecord {
+            id: pid.0,
+            seed: seed.0,
+            faces_in: patch.faces.len(),
+            unprocessed_in,
+            faces_out: new_faces.len(),
+            cone_angle_deg: patch.cone.map(|c| c.angle.to_degrees()),
+            distortion: param.report.clone(),
+        });
+        n_patch += 1;
+        on_progress(Progress {
+            patches: n_patch,
+            unprocessed: work.unprocessed(),
+            total,
+        });
+    }
+
+    work.compact();
+    let t0 = Instant::now();
+    if options.check_self_intersections {
+        invariants::certify_no_self_intersections(&work.mesh).map_err(PipelineError::Final)?;
+        cert.no_self_intersections = 1;
+    }
+    times.final_check = t0.elapsed().as_secs_f64();
+    let report = RemeshReport {
+        options: options.clone(),
+        stages: [
+            stages.patches.name().to_string(),
+            stages.parameterizer.name().to_string(),
+            stages.remesher.name().to_string(),
+        ],
+        l_avg,
+        l_tar,
+        patches: n_patch,
+        times,
+        certificate: cert,
+        patch_records: records,
+        faces_in: reference.n_faces(),
+        faces_out: work.mesh.n_faces(),
+        vertices_out: work.mesh.n_vertices(),
+    };
+    Ok(RemeshResult {
+        mesh: work.mesh,
+        locations: work.locations,
+        report,
+    })
+}
+
+/// The new faces of a candidate replacement: none degenerate (exact), none flipped against
+/// the reference surface (normal more than 90° from the normal of the reference face closest
+/// to the face's centroid).
+fn certify_replacement(
+    field: &MetricField,
+    work: &WorkingMesh,
+    r: &Replacement,
+) -> Result<(), InvariantError> {
+    use crate::stitch::PatchVertex;
+    let pos = |v: &PatchVertex| match *v {
+        PatchVertex::Existing(g) => work.mesh.positions[g.idx()],
+        PatchVertex::New(i) => r.new_positions[i as usize],
+    };
+    let mut degenerate = Vec::new();
+    let mut flipped = Vec::new();
+    for (i, t) in r.triangles.iter().enumerate() {
+        let p = [pos(&t[0]), pos(&t[1]), pos(&t[2])];
+        // Index in the stitched mesh is unknown yet: report the replacement index as a face id
+        // of the candidate.
+        let f = FaceId::new(i);
+        if collinear(&p) {
+            degenerate.push(f);
+            continue;
+        }
+        let n = (p[1] - p[0]).cross(&(p[2] - p[0]));
+        let c = nalgebra::Point3::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
+        let (loc, _) = field.project(&c);
+        if n.dot(&field.face_normal(loc.face)) <= 0.0 {
+            flipped.push(f);
+        }
+    }
+    if !degenerate.is_empty() {
+        return Err(InvariantError::DegenerateFaces(Offenders(degenerate)));
+    }
+    if !flipped.is_empty() {
+        return Err(InvariantError::FlippedFaces(Offenders(flipped)));
+    }
+    Ok(())
+}
+
+/// Exact: the three points are collinear iff all three coordinate projections are.
+fn collinear(p: &[nalgebra::Point3<f64>; 3]) -> bool {
+    use crate::predicates::{orient2d, Sign};
+    use nalgebra::Point2;
+    let proj = |i: usize, j: usize| {
+        orient2d(
+            &Point2::new(p[0][i], p[0][j]),
+            &Point2::new(p[1][i], p[1][j]),
+            &Point2::new(p[2][i], p[2][j]),
+        ) == Sign::Zero
+    };
+    proj(0, 1) && proj(1, 2) && proj(2, 0)
+}
+
+/// Every boundary edge of the input is still a boundary edge of the working mesh, between the
+/// same vertices at the same positions (bit for bit).
+fn certify_input_boundary(
+    mesh: &TriMesh,
+    topo: &Topology,
+    reference: &TriMesh,
+    input_boundary: &[EdgeKey],
+) -> Result<(), InvariantError> {
+    if input_boundary.is_empty() {
+        return Ok(());
+    }
+    let now: HashSet<EdgeKey> = topo
+        .boundary_loops()
+        .iter()
+        .flat_map(|l| (0..l.len()).map(move |i| EdgeKey::new(l[i], l[(i + 1) % l.len()])))
+        .collect();
+    let mut moved = Vec::new();
+    let mut missing = Vec::new();
+    for e in input_boundary {
+        for v in [e.0, e.1] {
+            if mesh.positions[v.idx()] != reference.positions[v.idx()] {
+                moved.push(v);
+            }
+        }
+        if !now.contains(e) {
+            missing.push(*e);
+        }
+    }
+    if !moved.is_empty() {
+        moved.sort();
+        moved.dedup();
+        return Err(InvariantError::BoundaryVerticesMoved(Offenders(moved)));
+    }
+    if !missing.is_empty() {
+        return Err(InvariantError::BoundaryEdgesMissing(Offenders(missing)));
+    }
+    Ok(())
+}
+
+/// Write the offending patch (faces of `mesh`) as OBJ into the debug directory.
+fn write_debug(
+    options: &RemeshOptions,
+    patch: PatchId,
+    what: &str,
+    mesh: &TriMesh,
+    faces: &[FaceId],
+) -> Option<PathBuf> {
+    let dir = options.debug_dir.as_ref()?;
+    let sub = TriMesh {
+        positions: mesh.positions.clone(),
+        triangles: faces.iter().map(|f| mesh.triangles[f.idx()]).collect(),
+    };
+    let (sub, _) = sub.without_unreferenced_vertices();
+    let path = dir.join(format!("conemesh-failed-{patch}-{what}.obj"));
+    crate::io::write_mesh(&path, &sub).ok()?;
+    Some(path)
 }
