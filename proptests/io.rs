@@ -136,3 +136,62 @@ proptest! {
         }
     }
 }
+
+/// Valid files of every format and encoding, for mutation (written once).
+fn valid_files() -> &'static [(conemesh::io::Format, Vec<u8>)] {
+    static FILES: std::sync::OnceLock<Vec<(conemesh::io::Format, Vec<u8>)>> =
+        std::sync::OnceLock::new();
+    FILES.get_or_init(write_valid_files)
+}
+
+fn write_valid_files() -> Vec<(conemesh::io::Format, Vec<u8>)> {
+    use conemesh::io::Format;
+    let m = surface(0, 1, 0);
+    let attrs = MeshAttributes {
+        face_ints: vec![("patch".into(), vec![1; m.n_faces()])],
+        face_colors: Some(vec![[1, 2, 3]; m.n_faces()]),
+        uv: Some(vec![Point2::new(0.5, 0.5); m.n_vertices()]),
+    };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut out = Vec::new();
+    for (name, f, binary, big_endian) in [
+        ("m.obj", Format::Obj, false, false),
+        ("m.off", Format::Off, false, false),
+        ("m.mesh", Format::Medit, false, false),
+        ("a.ply", Format::Ply, false, false),
+        ("le.ply", Format::Ply, true, false),
+        ("be.ply", Format::Ply, true, true),
+        ("a.stl", Format::Stl, false, false),
+        ("b.stl", Format::Stl, true, false),
+    ] {
+        let path = dir.path().join(name);
+        write_mesh_with(&path, &m, &attrs, &WriteOptions { binary, big_endian }).expect("write");
+        out.push((f, std::fs::read(&path).expect("read back")));
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..config() })]
+
+    /// Readers never panic: random byte edits and truncations of valid files either read or
+    /// give a typed error.
+    #[test]
+    fn mutated_files_never_panic(which in 0usize..8,
+                                 edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 0..6),
+                                 cut in any::<prop::sample::Index>(), do_cut in any::<bool>()) {
+        let files = valid_files();
+        let (format, mut bytes) = files[which].clone();
+        for (at, b) in edits {
+            let i = at.index(bytes.len());
+            bytes[i] = b;
+        }
+        if do_cut {
+            bytes.truncate(cut.index(bytes.len() + 1));
+        }
+        let r = conemesh::io::read_mesh_bytes(&bytes, format, "fuzz");
+        if let Err(e) = r {
+            prop_assert!(e.to_string().starts_with("fuzz"));
+        }
+    }
+}
