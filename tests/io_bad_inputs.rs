@@ -106,3 +106,25 @@ fn topological_defects_read_and_convert() {
         assert!(out.exists());
     }
 }
+
+/// `conemesh check` exits non-zero on every file of the corpus: 2 when it cannot read it,
+/// 1 when it reads but is invalid (the topological defects), never with a panic.
+#[test]
+fn cli_check_rejects_the_whole_corpus() {
+    for (file, kind) in corpus() {
+        let input = PathBuf::from(DIR).join(&file);
+        let out = Command::new(env!("CARGO_BIN_EXE_conemesh"))
+            .arg("check")
+            .arg(&input)
+            .output()
+            .expect("run conemesh");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{file}: {stderr}");
+        let expected_code = if kind == "ok" { 1 } else { 2 };
+        assert_eq!(out.status.code(), Some(expected_code), "{file}: {stderr}");
+        if kind == "ok" {
+            let stdout = String::from_utf8_lossy(&out.stdout);
+            assert!(stdout.contains("valid: no"), "{file}: {stdout}");
+        }
+    }
+}

@@ -97,7 +97,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         // Each record takes at least k tokens of 2 bytes.
         check_claim(path, F, "records", n, 2 * k as u64, bytes.len() + 1)?;
         let mut rec = [""; 9];
-        for i in 0..n as usize {
+        for _ in 0..n {
             for slot in rec.iter_mut().take(k) {
                 *slot = t.next().ok_or_else(|| trunc(tok, t.last_line))?.1;
             }
@@ -125,9 +125,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
                     }
                     refs.push(int(rec[k - 1], rl, path, F)?);
                 }
-                _ => {
-                    let _ = i;
-                }
+                _ => {} // a skipped section: its record was consumed above
             }
         }
         if !matches!(key.as_str(), "vertices" | "triangles" | "quadrilaterals") {

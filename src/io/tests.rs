@@ -435,3 +435,11 @@ fn failed_write_leaves_no_file() {
     let left: Vec<_> = std::fs::read_dir(dir.path()).expect("dir").collect();
     assert!(left.is_empty(), "{left:?}");
 }
+
+#[test]
+fn utf8_byte_order_mark_is_skipped() -> Result<(), IoError> {
+    let m = rd("\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Format::Obj)?;
+    assert_eq!(m.mesh.n_vertices(), 3);
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+    Ok(())
+}

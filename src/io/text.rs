@@ -11,7 +11,8 @@ pub(crate) fn as_text<'a>(
 ) -> Result<&'a str, IoError> {
     let bad_at = match std::str::from_utf8(bytes) {
         Ok(s) => match s.find('\0') {
-            None => return Ok(s),
+            // A UTF-8 byte-order mark is not part of the first keyword.
+            None => return Ok(s.strip_prefix('\u{feff}').unwrap_or(s)),
             Some(i) => i,
         },
         Err(e) => e.valid_up_to(),
