@@ -20,6 +20,20 @@ use std::io::Write;
 use std::path::Path;
 use thiserror::Error;
 
+/// At most 24 characters of a byte string, non-printable bytes shown as `?`.
+pub(crate) fn printable(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(&bytes[..bytes.len().min(24)])
+        .chars()
+        .map(|c| {
+            if c.is_ascii_graphic() || c == ' ' {
+                c
+            } else {
+                '?'
+            }
+        })
+        .collect()
+}
+
 /// " line N" for text formats, nothing for binary ones (line 0).
 fn loc(line: &usize) -> String {
     if *line == 0 {
@@ -57,7 +71,7 @@ pub enum IoError {
         format: &'static str,
     },
     /// The file does not start with the format's magic word.
-    #[error("{path}: not a {format} file (starts with {found:?})")]
+    #[error("{path}: wrong magic for {format} (file starts with {found:?})")]
     BadMagic {
         /// the file
         path: String,
@@ -88,8 +102,9 @@ pub enum IoError {
         /// what was expected and what was found
         message: String,
     },
-    /// A header claims more elements than the file can hold or a `u32` id can name.
-    #[error("{path}: {format} header claims {claimed} {what}, more than the file ({file_bytes} bytes) can hold or u32 ids can name")]
+    /// A header claims more elements than a `u32` id can name (a file claiming more than it
+    /// can hold, but fewer than that, is [`IoError::Truncated`]).
+    #[error("{path}: {format} header claims {claimed} {what}, more than u32 ids can name (file has {file_bytes} bytes)")]
     TooLarge {
         /// the file
         path: String,
@@ -528,7 +543,9 @@ pub(crate) fn capped(claimed: u64, available: usize, min_bytes: usize) -> usize 
     (claimed.min((available / min_bytes.max(1)) as u64)) as usize
 }
 
-/// Refuse a claimed count that cannot be indexed by `u32` or cannot fit in the file.
+/// Refuse a claimed count that a `u32` id cannot name ([`IoError::TooLarge`]) or that the
+/// file cannot hold at `min_bytes` per element ([`IoError::Truncated`]), before anything is
+/// allocated for it.
 pub(crate) fn check_claim(
     path: &str,
     format: &'static str,
@@ -537,13 +554,22 @@ pub(crate) fn check_claim(
     min_bytes: u64,
     file_bytes: usize,
 ) -> Result<(), IoError> {
-    if claimed > u32::MAX as u64 || claimed.saturating_mul(min_bytes) > file_bytes as u64 {
+    if claimed > u32::MAX as u64 {
         return Err(IoError::TooLarge {
             path: path.to_string(),
             format,
             what,
             claimed,
             file_bytes: file_bytes as u64,
+        });
+    }
+    if claimed.saturating_mul(min_bytes) > file_bytes as u64 {
+        return Err(IoError::Truncated {
+            path: path.to_string(),
+            format,
+            message: format!(
+                "header claims {claimed} {what}, more than the file's {file_bytes} bytes can hold"
+            ),
         });
     }
     Ok(())

@@ -2,7 +2,7 @@
 //! Variants `COFF`, `NOFF`, `STOFF`, … carry extra per-vertex values, which are skipped
 //! (each vertex and face is one line). Binary OFF and 4D/nD OFF are refused by name.
 
-use super::text::{as_text, count, float, int, short};
+use super::text::{as_text, count, float, int};
 use super::{build_mesh, check_claim, IoError, LoadedMesh, RawFaces};
 use crate::mesh::TriMesh;
 use nalgebra::Point3;
@@ -30,7 +30,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         return Err(IoError::BadMagic {
             path: path.to_string(),
             format: F,
-            found: short(first),
+            found: super::printable(first.as_bytes()),
         });
     };
     if prefix.contains('4') || prefix.contains('n') {

@@ -11,7 +11,8 @@ pub(crate) fn as_text<'a>(
 ) -> Result<&'a str, IoError> {
     let bad_at = match std::str::from_utf8(bytes) {
         Ok(s) => match s.find('\0') {
-            None => return Ok(s),
+            // A UTF-8 byte-order mark is not part of the first keyword.
+            None => return Ok(s.strip_prefix('\u{feff}').unwrap_or(s)),
             Some(i) => i,
         },
         Err(e) => e.valid_up_to(),
@@ -32,15 +33,22 @@ pub(crate) struct Tokens<'a> {
     line: usize,
     /// Line of the last token returned (or of the end of the file).
     pub(crate) last_line: usize,
+    first: usize,
 }
 
 impl<'a> Tokens<'a> {
     pub(crate) fn new(text: &'a str) -> Self {
+        Self::starting_at(text, 1)
+    }
+
+    /// Tokens of `text` whose first line is line `first` of the file.
+    pub(crate) fn starting_at(text: &'a str, first: usize) -> Self {
         Tokens {
             lines: text.lines().enumerate(),
             cur: "".split_ascii_whitespace(),
-            line: 0,
-            last_line: 0,
+            line: first.saturating_sub(1),
+            last_line: first.saturating_sub(1),
+            first,
         }
     }
 }
@@ -54,7 +62,7 @@ impl<'a> Iterator for Tokens<'a> {
                 return Some((self.line, t));
             }
             let (i, l) = self.lines.next()?;
-            self.line = i + 1;
+            self.line = i + self.first;
             self.last_line = self.line;
             let l = l.split('#').next().unwrap_or("");
             self.cur = l.split_ascii_whitespace();
