@@ -5,7 +5,10 @@
 //! Case counts are fixed (`CASES`) so the suite's time is stable.
 
 use conemesh::check::{check_mesh, CheckOptions, CheckReport};
-use conemesh::invariants::{certify_boundary_preserved, certify_same_topology, self_intersections};
+use conemesh::invariants::{
+    certify_boundary_preserved, certify_same_topology, faces_intersect, is_degenerate,
+    self_intersections,
+};
 use conemesh::mesh::generators;
 use conemesh::{Topology, TriMesh, VertexId};
 use nalgebra::Point3;
@@ -124,6 +127,27 @@ proptest! {
         prop_assert_eq!(certify_boundary_preserved(&m, &p).is_ok(), which != 2);
     }
 
+    /// The BVH broad phase loses no pair: on a small, heavily crumpled sphere (many crossing,
+    /// touching and folded faces) `self_intersections` equals the all-pairs brute force.
+    #[test]
+    fn self_intersections_equal_brute_force(seed in any::<u64>(), amp in 0.05..0.6f64) {
+        let m = generators::perturb(&generators::icosphere(1.0, 1), amp, &mut rng(seed));
+        let mut slow = Vec::new();
+        for i in m.faces() {
+            if is_degenerate(&m, i) {
+                slow.push((i, i));
+                continue;
+            }
+            for j in m.faces().filter(|&j| j > i && !is_degenerate(&m, j)) {
+                if faces_intersect(&m, i, j) {
+                    slow.push((i, j));
+                }
+            }
+        }
+        slow.sort_unstable();
+        prop_assert_eq!(self_intersections(&m), slow);
+    }
+
     #[test]
     fn verdicts_are_invariant_under_relabelling(seed in any::<u64>(), which in 0usize..4) {
         let mut m = match which {
@@ -145,4 +169,17 @@ proptest! {
         prop_assert!(certify_same_topology(&m, &s).is_ok());
         prop_assert!(certify_boundary_preserved(&m, &s).is_ok());
     }
+}
+
+/// The crumpled spheres of `self_intersections_equal_brute_force` do self-intersect (so the
+/// comparison is not between two empty lists).
+#[test]
+fn crumpled_spheres_self_intersect() {
+    let hits = (0..8u64)
+        .filter(|&seed| {
+            let m = generators::perturb(&generators::icosphere(1.0, 1), 0.6, &mut rng(seed));
+            !self_intersections(&m).is_empty()
+        })
+        .count();
+    assert!(hits >= 4, "{hits} of 8");
 }

@@ -137,7 +137,7 @@ pub fn point_in_triangle(
     p: &Point2<f64>,
 ) -> Option<usize> {
     let s = [orient2d(a, b, p), orient2d(b, c, p), orient2d(c, a, p)];
-    if s.iter().any(|x| *x == Sign::Negative) {
+    if s.contains(&Sign::Negative) {
         return None;
     }
     Some(s.iter().filter(|x| **x == Sign::Zero).count())
