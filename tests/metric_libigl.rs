@@ -130,7 +130,7 @@ fn compare(mesh: &str, reference: &str) -> Result<Agreement, Box<dyn std::error:
         }
         let scale_ref = r.pv1.abs().max(r.pv2.abs());
         // Not tiny: radius of curvature below 10 bounding-box diagonals.
-        if !(scale_ref * diag > 0.1) || r.pd1.norm() == 0.0 {
+        if scale_ref * diag <= 0.1 || r.pd1.norm() == 0.0 {
             continue;
         }
         // Ours in file units, ordered algebraically like libigl (pv1 ≥ pv2).

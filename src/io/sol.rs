@@ -130,7 +130,7 @@ pub fn read_sol(path: &Path, n_vertices: usize) -> Result<Vec<Matrix3<f64>>, Sol
         }
         if raw.kind == TYPE_SCALAR {
             let h = x[0];
-            if !(h > 0.0) {
+            if h <= 0.0 {
                 return Err(SolError::InvalidSize {
                     path: p,
                     vertex: v,

@@ -73,7 +73,7 @@ const MIN_NEIGHBOURS: usize = 5;
 /// A zero `n` gives `(x, y)`.
 pub fn tangent_frame(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     let l = n.norm();
-    if !(l > 0.0) || !l.is_finite() {
+    if !l.is_finite() || l <= 0.0 {
         return (Vector3::x(), Vector3::y());
     }
     let n = n / l;
@@ -206,7 +206,7 @@ fn fit_vertex(
     // Frame normal: the vertex's own area-weighted normal (libigl's default, `localMode` with
     // `AVERAGE` normals).
     let n0 = normals[v];
-    if !(n0.norm() > 0.0) || ring.len() < 2 {
+    if !n0.norm().is_finite() || n0.norm() <= 0.0 || ring.len() < 2 {
         return planar(n0);
     }
     let n0 = n0.normalize();
@@ -235,7 +235,7 @@ fn fit_vertex(
         .iter()
         .map(|q| (q.x * q.x + q.y * q.y).sqrt())
         .fold(0.0f64, f64::max);
-    if !(h > 0.0) || !h.is_finite() {
+    if !h.is_finite() || h <= 0.0 {
         return planar(n0);
     }
     // Least squares z = a u² + b uv + c v² + d u + e v on coordinates scaled by 1/h, so that
@@ -297,7 +297,7 @@ fn fit_vertex(
     let normal = n0;
     let d1 = pairs[0].1;
     let l = d1.norm();
-    if !(l > 0.0) || !l.is_finite() {
+    if !l.is_finite() || l <= 0.0 {
         return planar(normal);
     }
     let d1 = d1 / l;
