@@ -5,14 +5,16 @@
 //! For every vertex `v`:
 //! 1. the neighbourhood is the set of vertices within `radius` edge rings of `v` (grown further
 //!    if it has fewer than 5 other vertices, libigl's minimum of 6 points);
-//! 2. the frame normal `n₀` is the normalised sum of the (area-weighted) vertex normals of the
-//!    neighbourhood (libigl's default `PROJ_PLANE` normal), with a tangent pair `(t₁, t₂)`;
+//! 2. the frame normal `n₀` is the vertex's area-weighted normal, with a tangent pair
+//!    `(t₁, t₂)`; neighbours whose normal faces away from `n₀` (more than 90°, e.g. across a
+//!    sharp feature line) are dropped when at least 5 remain (libigl's defaults: `localMode`,
+//!    `AVERAGE` normal, `projectionPlaneCheck`);
 //! 3. the height function `z = a u² + b uv + c v² + d u + e v` (libigl's quadric: no constant
 //!    term, the surface passes through `v`) is fitted to the neighbours' frame coordinates by
 //!    least squares (SVD, coordinates scaled by the neighbourhood size for conditioning);
-//! 4. the principal curvatures are the eigenvalues of the shape operator of the fitted surface at
-//!    `v`, `II x = −k I x` with the first/second fundamental forms `I`, `II` of the graph, and
-//!    the principal directions are the eigenvectors mapped to 3D tangent vectors `x_u x¹ + x_v x²`.
+//! 4. the principal curvatures are (minus) the eigenvalues of the fitted surface's shape operator
+//!    `I⁻¹ II` at `v`, symmetrised as libigl does, and the principal directions its eigenvectors
+//!    mapped to 3D in the tangent plane of `n₀` (`t₁ x¹ + t₂ x²`), as libigl does.
 //!
 //! Sign: `k > 0` where the surface bends away from its normal (a sphere with outward normals has
 //! `k₁ = k₂ = +1/r`), as in libigl.
@@ -53,7 +55,8 @@ pub struct PrincipalCurvature {
     pub d1: Vector3<f64>,
     /// Unit principal direction of `k2` (`normal × d1`).
     pub d2: Vector3<f64>,
-    /// Unit normal of the fitted surface at the vertex.
+    /// Unit normal at the vertex: the area-weighted vertex normal (the fit's frame normal), so
+    /// that the curvature metric is degenerate exactly along the mesh's vertex normal.
     pub normal: Vector3<f64>,
 }
 
@@ -200,18 +203,25 @@ fn fit_vertex(
     v: usize,
     ring: &[u32],
 ) -> PrincipalCurvature {
-    // Frame normal: sum of the neighbourhood's vertex normals (libigl PROJ_PLANE).
-    let mut n0 = normals[v];
-    for &w in ring {
-        n0 += normals[w as usize];
-    }
-    if !(n0.norm() > 0.0) {
-        n0 = normals[v];
-    }
+    // Frame normal: the vertex's own area-weighted normal (libigl's default, `localMode` with
+    // `AVERAGE` normals).
+    let n0 = normals[v];
     if !(n0.norm() > 0.0) || ring.len() < 2 {
         return planar(n0);
     }
     let n0 = n0.normalize();
+    // libigl's `projectionPlaneCheck`: drop neighbours facing away (normal more than 90° from
+    // n₀), e.g. across a sharp feature line, when enough remain and some were dropped.
+    let facing: Vec<u32> = ring
+        .iter()
+        .copied()
+        .filter(|&w| normals[w as usize].dot(&n0) > 0.0)
+        .collect();
+    let ring: &[u32] = if facing.len() >= MIN_NEIGHBOURS && facing.len() < ring.len() {
+        &facing
+    } else {
+        ring
+    };
     let (t1, t2) = tangent_frame(&n0);
     let p = positions[v];
     let local: Vec<Vector3<f64>> = ring
@@ -252,31 +262,24 @@ fn fit_vertex(
     if ![a, b, c, d, e].iter().all(|x| x.is_finite()) {
         return planar(n0);
     }
-    // Fundamental forms of the graph (u, v, f(u, v)) at the origin.
+    // Fundamental forms of the graph (u, v, f(u, v)) at the origin: I = [[E, F], [F, G]],
+    // II = [[L, M], [M, N]] with the fitted surface's unit normal (−d, −e, 1)/w.
     let w = (1.0 + d * d + e * e).sqrt();
-    let first = Matrix2::new(1.0 + d * d, d * e, d * e, 1.0 + e * e);
-    let second = Matrix2::new(2.0 * a / w, b / w, b / w, 2.0 * c / w);
-    let normal_local = Vector3::new(-d, -e, 1.0) / w;
-    let normal = (t1 * normal_local.x + t2 * normal_local.y + n0 * normal_local.z).normalize();
-    // Generalised symmetric eigenproblem II x = λ I x via the Cholesky factor I = R Rᵀ:
-    // S = R⁻¹ II R⁻ᵀ, x = R⁻ᵀ y. I is SPD (det = 1 + d² + e² > 0).
-    let r11 = first[(0, 0)].sqrt();
-    let r21 = first[(1, 0)] / r11;
-    let r22 = (first[(1, 1)] - r21 * r21).sqrt();
-    let r = Matrix2::new(r11, 0.0, r21, r22);
-    let Some(r_inv) = r.try_inverse() else {
-        return planar(normal);
-    };
-    let s = r_inv * second * r_inv.transpose();
-    let s = (s + s.transpose()) * 0.5;
-    let eig = SymmetricEigen::new(s);
+    let (ee, ff, gg) = (1.0 + d * d, d * e, 1.0 + e * e);
+    let (l, m_, nn) = (2.0 * a / w, b / w, 2.0 * c / w);
+    // Shape operator I⁻¹ II, symmetrised as libigl does (its off-diagonal M E − L F on both
+    // sides; exact when d = e = 0, i.e. when the vertex normal is the fitted normal, and off by
+    // O(d² + e²) otherwise). The symmetric form keeps the principal directions orthogonal in the
+    // tangent plane of the vertex normal n₀, which is where the metric is used (Sec. 4.1 builds
+    // M from (d₁, d₂, d₁ × d₂); Eq. 4 projects onto the plane of d₁, d₂).
+    let off = m_ * ee - l * ff;
+    let shape = Matrix2::new(l * gg - m_ * ff, off, off, nn * ee - m_ * ff) / (ee * gg - ff * ff);
+    let eig = SymmetricEigen::new(shape);
     // k = −λ: the graph of a sphere seen from its outward normal has f = −(u²+v²)/2r, λ = −1/r.
     let mut pairs: Vec<(f64, Vector3<f64>)> = (0..2)
         .map(|i| {
-            let y = eig.eigenvectors.column(i).into_owned();
-            let x = r_inv.transpose() * y;
-            let tangent = (t1 + n0 * d) * x[0] + (t2 + n0 * e) * x[1];
-            (-eig.eigenvalues[i], tangent)
+            let y = eig.eigenvectors.column(i);
+            (-eig.eigenvalues[i], t1 * y[0] + t2 * y[1])
         })
         .collect();
     pairs.sort_by(|p, q| {
@@ -286,12 +289,13 @@ fn fit_vertex(
     });
     let (k1, k2) = (pairs[0].0, pairs[1].0);
     if !(k1.is_finite() && k2.is_finite()) {
-        return planar(normal);
+        return planar(n0);
     }
     if k1.abs() * h <= PLANAR_RELATIVE {
-        return planar(normal);
+        return planar(n0);
     }
-    let d1 = pairs[0].1 - normal * normal.dot(&pairs[0].1);
+    let normal = n0;
+    let d1 = pairs[0].1;
     let l = d1.norm();
     if !(l > 0.0) || !l.is_finite() {
         return planar(normal);
