@@ -202,3 +202,15 @@ fn sampling_is_seeded() {
     assert_eq!(d1, d2);
     assert!(d1.hausdorff > 0.01 && d1.hausdorff < 0.1, "{d1:?}");
 }
+
+#[test]
+fn unreferenced_vertices_are_not_samples() {
+    // Regression (stanford-bunny has 1113 unreferenced scan vertices): a stray vertex far
+    // from the surface must not count as a distance.
+    let a = generators::disk(1.0, 4, 6);
+    let mut b = a.clone();
+    b.positions.push(Point3::new(0.0, 0.0, 5.0));
+    let d = approximation_error(&a, &b, 1_000, &mut Rng::seed_from_u64(4));
+    assert!(d.hausdorff < 1e-12, "{d:?}");
+    assert_eq!(d.samples, 2 * (a.n_vertices() + 1_000));
+}

@@ -74,10 +74,24 @@ pub struct Distance {
     pub samples: usize,
 }
 
-/// Vertices of `m` plus `n_random` area-weighted uniform random points on its triangles.
+/// Referenced vertices of `m` plus `n_random` area-weighted uniform random points on its triangles.
 /// Returns (points, number of random points among them, which come last).
 fn sample_surface(m: &TriMesh, n_random: usize, rng: &mut crate::Rng) -> (Vec<Point3<f64>>, usize) {
-    let mut pts: Vec<Point3<f64>> = m.positions.clone();
+    // Only vertices some face uses: unreferenced vertices (raw scans have them) are not on
+    // the surface.
+    let mut used = vec![false; m.n_vertices()];
+    for t in &m.triangles {
+        for v in t {
+            used[v.idx()] = true;
+        }
+    }
+    let mut pts: Vec<Point3<f64>> = m
+        .positions
+        .iter()
+        .zip(&used)
+        .filter(|(_, &u)| u)
+        .map(|(p, _)| *p)
+        .collect();
     // Cumulative area, for choosing a face with probability proportional to its area.
     let mut cdf = Vec::with_capacity(m.n_faces());
     let mut acc = 0.0;
@@ -125,7 +139,7 @@ fn one_side(pts: &[Point3<f64>], n_random: usize, target: &SurfaceProjector) -> 
 
 /// Two-sided sampled approximation error between surfaces `a` (the input) and `b`.
 ///
-/// Each surface is sampled at all its vertices plus `min_samples` area-weighted random
+/// Each surface is sampled at all its vertices used by a face, plus `min_samples` area-weighted random
 /// points (seeded by `rng`; first `a`'s, then `b`'s), and every sample is measured to the
 /// other surface by the exact point-triangle distance (parry BVH). Hausdorff is the larger
 /// of the two one-sided maxima; RMS is over the random samples of both sides; relative
