@@ -17,7 +17,7 @@ use nalgebra::{Matrix3, Vector3};
 /// (areas). Zero total weight or no normals gives the axis `+z` and angle 0.
 pub fn fit_cone_normals(normals: &[Vector3<f64>], weights: &[f64]) -> Cone {
     let total: f64 = weights.iter().sum();
-    if normals.is_empty() || !(total > 0.0) {
+    if normals.is_empty() || total.is_nan() || total <= 0.0 {
         return Cone {
             axis: Vector3::z(),
             angle: 0.0,

@@ -317,7 +317,7 @@ impl Grown<'_, '_> {
                 });
                 continue;
             }
-            if !(top.cost < opts.c_max) {
+            if top.cost.is_nan() || top.cost >= opts.c_max {
                 // Refresh stale entries before giving up.
                 let entries: Vec<Entry> = heap.drain().collect();
                 let mut any_stale = false;

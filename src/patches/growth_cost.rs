@@ -53,7 +53,7 @@ pub fn growth_cost(e: f64, d: f64, area_p: f64, beta: f64) -> f64 {
     if e == 0.0 || d == 0.0 {
         return 0.0;
     }
-    if !(area_p > 0.0) {
+    if area_p.is_nan() || area_p <= 0.0 {
         return f64::INFINITY;
     }
     e * (d / area_p.sqrt()).powf(2.0 * beta)
