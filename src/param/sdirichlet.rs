@@ -37,7 +37,8 @@ pub struct SdOptions {
     pub init_weights: TutteWeights,
     /// Newton iteration budget [50]; running out is reported (`hit_budget`), not an error.
     pub max_iters: usize,
-    /// Stop when the relative energy decrease of a step is below this [1e-4].
+    /// Stop when a step decreases the energy excess `E − 4` over an isometry by less than
+    /// this fraction [1e-4].
     pub rel_tol: f64,
     /// Fraction of the largest flip-free step tried first [0.9].
     pub step_fraction: f64,
@@ -551,7 +552,7 @@ pub fn optimize_with_log(
         let Some(e_new) = accepted else {
             // No certified decrease along the Newton direction: keep the last certified
             // iterate. If the direction still promised a real decrease, report a fallback.
-            log.fell_back = -slope > options.rel_tol * energy;
+            log.fell_back = -slope > options.rel_tol * (energy - 4.0).max(0.0);
             converged = !log.fell_back;
             break;
         };
@@ -561,7 +562,9 @@ pub fn optimize_with_log(
         log.energies.push(e_new);
         log.min_double_area
             .push(min_double_area(&uv, &disk.triangles));
-        let rel = (energy - e_new) / energy.abs().max(f64::MIN_POSITIVE);
+        // Relative decrease of the excess over the isometric lower bound 4 (σ² + σ⁻² ≥ 2):
+        // relative to E itself the constant 4 would stop developable patches early.
+        let rel = (energy - e_new) / (energy - 4.0).max(f64::MIN_POSITIVE);
         energy = e_new;
         if rel < options.rel_tol {
             converged = true;
