@@ -35,7 +35,7 @@ pub struct SdOptions {
     /// theorem applies; symmetric, so solved by sparse Cholesky, ~5× faster than the LU that
     /// mean-value weights need; uniform weights are the certified fallback).
     pub init_weights: TutteWeights,
-    /// Newton iteration budget [50]; running out is reported (`hit_budget`), not an error.
+    /// Newton iteration budget [100]; running out is reported (`hit_budget`), not an error.
     pub max_iters: usize,
     /// Stop when a step decreases the energy excess `E − 4` over an isometry by less than
     /// this fraction [1e-4].
@@ -55,7 +55,7 @@ impl Default for SdOptions {
     fn default() -> Self {
         SdOptions {
             init_weights: TutteWeights::Cotan,
-            max_iters: 50,
+            max_iters: 100,
             rel_tol: 1e-4,
             step_fraction: 0.9,
             armijo: 1e-4,
@@ -492,6 +492,7 @@ pub fn optimize_with_log(
         .push(min_double_area(&uv, &disk.triangles));
     let mut converged = false;
     let mut trial = uv.clone();
+    let mut probe = uv.clone();
     while log.iterations < options.max_iters {
         lap();
         prob.assemble(&uv, &pat, &mut grad, &mut vals)?;
@@ -532,7 +533,8 @@ pub fn optimize_with_log(
             converged = true; // no descent direction left
             break;
         }
-        let mut t = (options.step_fraction * prob.max_flip_free_step(&uv, &dir)).min(1.0);
+        let t_safe = options.step_fraction * prob.max_flip_free_step(&uv, &dir);
+        let mut t = t_safe.min(1.0);
         let mut accepted = None;
         for _ in 0..40 {
             for v in 0..n {
@@ -547,6 +549,29 @@ pub fn optimize_with_log(
                 log.certificate_rejections += 1;
             }
             t *= 0.5;
+        }
+        // Extrapolation: far from the optimum the energy is dominated by compressed triangles
+        // (E ≈ J⁻²), where a full Newton step only grows J by 4/3; while the full step was
+        // taken and the flip-free bound allows more, keep doubling as long as the energy drops.
+        if let (Some(mut e_best), true) = (accepted, t == 1.0) {
+            let mut t_try = 2.0;
+            while t_try <= t_safe && t_try <= 1024.0 {
+                for v in 0..n {
+                    probe[v] = Point2::new(
+                        uv[v].x + t_try * dir[2 * v],
+                        uv[v].y + t_try * dir[2 * v + 1],
+                    );
+                }
+                let e = prob.energy(&probe);
+                if !(e < e_best) || certify(disk, &probe, boundary).is_err() {
+                    break;
+                }
+                e_best = e;
+                t = t_try;
+                std::mem::swap(&mut trial, &mut probe);
+                t_try *= 2.0;
+            }
+            accepted = Some(e_best);
         }
         log.time_ms[3] += lap();
         let Some(e_new) = accepted else {
