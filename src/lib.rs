@@ -11,6 +11,7 @@
 //! - [`pipeline`]: Algorithm 1.
 //! - [`quality`], [`report`]: Sec. 4.1, the yardstick.
 
+pub mod check;
 pub mod error;
 pub mod ids;
 pub mod invariants;

@@ -143,6 +143,235 @@ pub fn point_in_triangle(
     Some(s.iter().filter(|x| **x == Sign::Zero).count())
 }
 
+// ---------------------------------------------------------------------------------------
+// 3D intersection tests (self-intersection certificate).
+//
+// Every decision below is an `orient3d` or an `orient2d` sign (exact); no coordinate is ever
+// constructed. The key fact used throughout: two closed convex sets in 3D that are coplanar
+// (or lie on a common line) intersect iff their images under an axis projection that is
+// injective on their common plane intersect, and such an axis is found exactly as one whose
+// projected `orient2d` is non-zero.
+// ---------------------------------------------------------------------------------------
+
+/// Drop coordinate `axis` (0 = x, 1 = y, 2 = z): the projection on the other two axes.
+#[inline]
+fn project(p: &Point3<f64>, axis: usize) -> Point2<f64> {
+    match axis {
+        0 => Point2::new(p.y, p.z),
+        1 => Point2::new(p.z, p.x),
+        _ => Point2::new(p.x, p.y),
+    }
+}
+
+/// `true` when `p, q, r` lie on one line (or coincide), exactly: the three points are
+/// collinear in 3D iff their projections on the yz, zx and xy planes are all collinear
+/// (the three `orient2d` values are the components of `(q − p) × (r − p)`).
+pub fn collinear3d(p: &Point3<f64>, q: &Point3<f64>, r: &Point3<f64>) -> bool {
+    (0..3).all(|k| orient2d(&project(p, k), &project(q, k), &project(r, k)) == Sign::Zero)
+}
+
+/// An axis whose projection maps the plane of the non-degenerate triangle `p, q, r`
+/// one-to-one onto a coordinate plane, with the sign of the projected triangle. The axis of
+/// the largest float normal component is tried first (the dominant axis); the choice is then
+/// confirmed by the exact `orient2d`, so a wrong float guess only costs another try.
+/// `None` when the triangle is degenerate (collinear corners).
+fn projection_axis(p: &Point3<f64>, q: &Point3<f64>, r: &Point3<f64>) -> Option<(usize, Sign)> {
+    let n = (q - p).cross(&(r - p));
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| n[j].abs().total_cmp(&n[i].abs()));
+    order.iter().find_map(|&k| {
+        let s = orient2d(&project(p, k), &project(q, k), &project(r, k));
+        (s != Sign::Zero).then_some((k, s))
+    })
+}
+
+/// Closed 2D segment `[a, b]` against the closed non-degenerate triangle `t` whose
+/// orientation is `t_sign` (exact).
+fn segment_meets_triangle_2d(
+    a: &Point2<f64>,
+    b: &Point2<f64>,
+    t: &[Point2<f64>; 3],
+    t_sign: Sign,
+) -> bool {
+    let (p, q, r) = if t_sign == Sign::Negative {
+        (&t[0], &t[2], &t[1])
+    } else {
+        (&t[0], &t[1], &t[2])
+    };
+    point_in_triangle(p, q, r, a).is_some()
+        || point_in_triangle(p, q, r, b).is_some()
+        || [(p, q), (q, r), (r, p)]
+            .iter()
+            .any(|(u, v)| segments_intersect(a, b, u, v) != SegmentIntersection::Disjoint)
+}
+
+/// Exact intersection test of closed segments `[a, b]` and `[c, d]` in 3D (segments may be
+/// single points).
+///
+/// Non-coplanar segments never meet. Coplanar ones (including collinear ones) meet iff their
+/// projections on all three coordinate planes meet: meeting in 3D implies meeting in every
+/// projection, and at least one projection is injective on the common plane (or line), so
+/// its verdict is the 3D truth.
+pub fn segments_intersect_3d(
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    c: &Point3<f64>,
+    d: &Point3<f64>,
+) -> bool {
+    if orient3d(a, b, c, d) != Sign::Zero {
+        return false;
+    }
+    (0..3).all(|k| {
+        segments_intersect(
+            &project(a, k),
+            &project(b, k),
+            &project(c, k),
+            &project(d, k),
+        ) != SegmentIntersection::Disjoint
+    })
+}
+
+/// Closed segment `[a, b]` against the closed triangle `t`, given the sides `sa`, `sb` of
+/// `a`, `b` relative to the plane of `t` (`t` non-degenerate, projection `axis`/`t_sign`).
+fn segment_meets_nondegenerate_triangle(
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    sa: Sign,
+    sb: Sign,
+    t: &[Point3<f64>; 3],
+    axis: usize,
+    t_sign: Sign,
+) -> bool {
+    match (sa, sb) {
+        (Sign::Positive, Sign::Positive) | (Sign::Negative, Sign::Negative) => false,
+        (Sign::Zero, Sign::Zero) => {
+            let tp = [
+                project(&t[0], axis),
+                project(&t[1], axis),
+                project(&t[2], axis),
+            ];
+            segment_meets_triangle_2d(&project(a, axis), &project(b, axis), &tp, t_sign)
+        }
+        (Sign::Zero, _) | (_, Sign::Zero) => {
+            // Exactly one endpoint lies in the plane: it is the only candidate point.
+            let x = if sa == Sign::Zero { a } else { b };
+            let tp = [
+                project(&t[0], axis),
+                project(&t[1], axis),
+                project(&t[2], axis),
+            ];
+            let px = project(x, axis);
+            if t_sign == Sign::Negative {
+                point_in_triangle(&tp[0], &tp[2], &tp[1], &px).is_some()
+            } else {
+                point_in_triangle(&tp[0], &tp[1], &tp[2], &px).is_some()
+            }
+        }
+        _ => {
+            // The segment crosses the plane at one point strictly between a and b; that point
+            // is in the closed triangle iff the line ab sees the three edges with no two
+            // strictly opposite orientations (signed volumes ∝ barycentric coordinates).
+            let s = [
+                orient3d(a, b, &t[0], &t[1]),
+                orient3d(a, b, &t[1], &t[2]),
+                orient3d(a, b, &t[2], &t[0]),
+            ];
+            !(s.contains(&Sign::Positive) && s.contains(&Sign::Negative))
+        }
+    }
+}
+
+/// Exact intersection test of the closed segment `[a, b]` and the closed triangle `t` in 3D.
+/// A degenerate triangle (collinear corners) is treated as the segment it covers, i.e. the
+/// union of its three edges.
+pub fn segment_triangle_intersect(a: &Point3<f64>, b: &Point3<f64>, t: &[Point3<f64>; 3]) -> bool {
+    match projection_axis(&t[0], &t[1], &t[2]) {
+        Some((axis, t_sign)) => {
+            let sa = orient3d(&t[0], &t[1], &t[2], a);
+            let sb = orient3d(&t[0], &t[1], &t[2], b);
+            segment_meets_nondegenerate_triangle(a, b, sa, sb, t, axis, t_sign)
+        }
+        None => (0..3).any(|i| segments_intersect_3d(a, b, &t[i], &t[(i + 1) % 3])),
+    }
+}
+
+/// Exact intersection test of two closed triangles in 3D (`true` when they share at least one
+/// point, touching included). Degenerate triangles are treated as the segments (or points)
+/// they cover.
+///
+/// Möller's plane-side rejection first (three `orient3d` per plane); then the triangles
+/// meet iff an edge of one meets the other: the intersection of two convex polygons, if not
+/// empty, has an extreme point on the boundary of one of them. Every decision is an exact
+/// `orient3d`, or an exact `orient2d` on a projection chosen by [`projection_axis`].
+pub fn triangles_intersect(a: &[Point3<f64>; 3], b: &[Point3<f64>; 3]) -> bool {
+    let pa = projection_axis(&a[0], &a[1], &a[2]);
+    let pb = projection_axis(&b[0], &b[1], &b[2]);
+    let side = |t: &[Point3<f64>; 3], x: &Point3<f64>| orient3d(&t[0], &t[1], &t[2], x);
+    let separated = |s: &[Sign; 3]| {
+        s.iter().all(|x| *x == Sign::Positive) || s.iter().all(|x| *x == Sign::Negative)
+    };
+    // Sides of b's corners relative to a's plane, and vice versa (only for non-degenerate).
+    let sb = pa.map(|_| [side(a, &b[0]), side(a, &b[1]), side(a, &b[2])]);
+    if sb.as_ref().is_some_and(separated) {
+        return false;
+    }
+    let sa = pb.map(|_| [side(b, &a[0]), side(b, &a[1]), side(b, &a[2])]);
+    if sa.as_ref().is_some_and(separated) {
+        return false;
+    }
+    let edges_meet = |e: &[Point3<f64>; 3],
+                      es: Option<[Sign; 3]>,
+                      t: &[Point3<f64>; 3],
+                      tp: Option<(usize, Sign)>| {
+        (0..3).any(|i| {
+            let j = (i + 1) % 3;
+            match (tp, es) {
+                (Some((axis, t_sign)), Some(s)) => {
+                    segment_meets_nondegenerate_triangle(&e[i], &e[j], s[i], s[j], t, axis, t_sign)
+                }
+                _ => segment_triangle_intersect(&e[i], &e[j], t),
+            }
+        })
+    };
+    edges_meet(a, sa, b, pb) || edges_meet(b, sb, a, pa)
+}
+
+/// Two non-degenerate triangles `(p, q, r)` and `(p, q, s)` sharing the edge `pq`
+/// (in either direction): `true` when they overlap beyond that edge. Their planes meet in
+/// the line `pq` unless they are coplanar, so they overlap iff `p, q, r, s` are coplanar and
+/// `r`, `s` lie on the same side of `pq` (CGAL's `coplanar` + `coplanar_orientation`).
+/// Degenerate input returns `false` (callers report degenerate faces separately).
+pub fn edge_adjacent_triangles_overlap(
+    p: &Point3<f64>,
+    q: &Point3<f64>,
+    r: &Point3<f64>,
+    s: &Point3<f64>,
+) -> bool {
+    if orient3d(p, q, r, s) != Sign::Zero {
+        return false;
+    }
+    let Some((axis, sr)) = projection_axis(p, q, r) else {
+        return false;
+    };
+    orient2d(&project(p, axis), &project(q, axis), &project(s, axis)) == sr
+}
+
+/// Two non-degenerate triangles `(v, a, b)` and `(v, c, d)` sharing exactly the corner `v`:
+/// `true` when they meet anywhere else. The intersection is convex and contains `v`; any
+/// other point of it makes its far end lie on the edge opposite `v` of one triangle and inside
+/// the other, so the test is: `[c, d]` meets `(v, a, b)` or `[a, b]` meets `(v, c, d)` (the
+/// opposite edges do not contain `v`; CGAL's rule).
+pub fn vertex_adjacent_triangles_intersect(
+    v: &Point3<f64>,
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    c: &Point3<f64>,
+    d: &Point3<f64>,
+) -> bool {
+    segment_triangle_intersect(c, d, &[*v, *a, *b])
+        || segment_triangle_intersect(a, b, &[*v, *c, *d])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,6 +482,241 @@ mod tests {
             s((0., 0.), (1., 0.), (1., 0.), (1., 1.)),
             SegmentIntersection::Touching
         );
+    }
+
+    fn p3(x: f64, y: f64, z: f64) -> Point3<f64> {
+        Point3::new(x, y, z)
+    }
+
+    fn tri(a: (f64, f64, f64), b: (f64, f64, f64), c: (f64, f64, f64)) -> [Point3<f64>; 3] {
+        [p3(a.0, a.1, a.2), p3(b.0, b.1, b.2), p3(c.0, c.1, c.2)]
+    }
+
+    /// Both argument orders and all corner rotations must agree.
+    fn tt(a: &[Point3<f64>; 3], b: &[Point3<f64>; 3]) -> bool {
+        let r = triangles_intersect(a, b);
+        for k in 0..3 {
+            let ar = [a[k], a[(k + 1) % 3], a[(k + 2) % 3]];
+            let bf = [b[0], b[2], b[1]];
+            assert_eq!(triangles_intersect(&ar, b), r, "rotation {k}");
+            assert_eq!(triangles_intersect(b, &ar), r, "swap, rotation {k}");
+            assert_eq!(triangles_intersect(&ar, &bf), r, "flip, rotation {k}");
+        }
+        r
+    }
+
+    #[test]
+    fn triangles_crossing_and_separated() {
+        let a = tri((0., 0., 0.), (4., 0., 0.), (0., 4., 0.));
+        // Pierces a's interior.
+        assert!(tt(&a, &tri((1., 1., -1.), (1., 1., 1.), (2., 0.5, 1.))));
+        // Same shape moved above the plane.
+        assert!(!tt(&a, &tri((1., 1., 0.5), (1., 1., 1.), (2., 0.5, 1.))));
+        // Straddles the plane but passes outside the triangle (beyond the hypotenuse).
+        assert!(!tt(&a, &tri((3., 3., -1.), (3., 3., 1.), (5., 4., 0.))));
+        // Linked like two rings: each pierces the other's edge region.
+        let b = tri((2., -1., -1.), (2., -1., 1.), (2., 1., 0.));
+        assert!(tt(&a, &b));
+    }
+
+    #[test]
+    fn triangles_touching_at_a_point_or_edge() {
+        let a = tri((0., 0., 0.), (4., 0., 0.), (0., 4., 0.));
+        // A corner of b exactly on a's interior, the rest above.
+        assert!(tt(&a, &tri((1., 1., 0.), (1., 1., 1.), (2., 0.5, 1.))));
+        // A corner of b exactly on a's hypotenuse.
+        assert!(tt(&a, &tri((2., 2., 0.), (3., 3., 1.), (2., 3., 1.))));
+        // Corner to corner.
+        assert!(tt(&a, &tri((4., 0., 0.), (5., 0., 1.), (5., 1., 1.))));
+        // Edge of b lying on a's plane and crossing a's edge from outside.
+        assert!(tt(&a, &tri((-1., 1., 0.), (1., 1., 0.), (0., 1., 3.))));
+        // Same, but stopping short of the triangle.
+        assert!(!tt(&a, &tri((-2., 1., 0.), (-1., 1., 0.), (-1.5, 1., 3.))));
+    }
+
+    #[test]
+    fn coplanar_triangles() {
+        let a = tri((0., 0., 1.), (4., 0., 1.), (0., 4., 1.));
+        // Overlapping (a star of David-like crossing, no corner inside the other).
+        assert!(tt(&a, &tri((-1., 1., 1.), (3., -1., 1.), (3., 3., 1.))));
+        // b strictly inside a.
+        assert!(tt(&a, &tri((1., 1., 1.), (2., 1., 1.), (1., 2., 1.))));
+        // Sharing only part of an edge line, touching.
+        assert!(tt(&a, &tri((1., 0., 1.), (3., 0., 1.), (2., -2., 1.))));
+        // Disjoint in the plane.
+        assert!(!tt(&a, &tri((3., 3., 1.), (5., 3., 1.), (3., 5., 1.))));
+        // Tilted plane x + y + z = 3 (exact in binary), overlap and separation.
+        let c = tri((3., 0., 0.), (0., 3., 0.), (0., 0., 3.));
+        assert!(tt(&c, &tri((1., 1., 1.), (2., 1., 0.), (1., 2., 0.))));
+        assert!(!tt(&c, &tri((-1., 4., 0.), (-2., 4., 1.), (-1., 5., -1.))));
+    }
+
+    #[test]
+    fn degenerate_triangles_are_their_segments() {
+        let a = tri((0., 0., 0.), (4., 0., 0.), (0., 4., 0.));
+        // A "triangle" on a vertical segment through a's interior.
+        assert!(tt(&a, &tri((1., 1., -1.), (1., 1., 1.), (1., 1., 0.5))));
+        // Same segment beside the triangle.
+        assert!(!tt(&a, &tri((5., 1., -1.), (5., 1., 1.), (5., 1., 0.5))));
+        // A point (three equal corners) on the hypotenuse, and just off it.
+        assert!(tt(&a, &tri((2., 2., 0.), (2., 2., 0.), (2., 2., 0.))));
+        assert!(!tt(&a, &tri((2., 2.5, 0.), (2., 2.5, 0.), (2., 2.5, 0.))));
+        // Two degenerate triangles on crossing segments, and on skew ones.
+        let s = tri((0., 0., 0.), (2., 2., 0.), (1., 1., 0.));
+        assert!(tt(&s, &tri((0., 2., 0.), (2., 0., 0.), (0.5, 1.5, 0.))));
+        assert!(!tt(&s, &tri((0., 2., 1.), (2., 0., 1.), (0.5, 1.5, 1.))));
+        assert!(collinear3d(&s[0], &s[1], &s[2]));
+        assert!(!collinear3d(&a[0], &a[1], &a[2]));
+    }
+
+    #[test]
+    fn shared_edge_overlaps_only_when_folded_over() {
+        let (p, q) = (p3(0., 0., 0.), p3(2., 0., 0.));
+        let r = p3(1., 1., 0.);
+        // Flat continuation across the edge: no overlap.
+        assert!(!edge_adjacent_triangles_overlap(
+            &p,
+            &q,
+            &r,
+            &p3(1., -1., 0.)
+        ));
+        // Bent dihedral: no overlap.
+        assert!(!edge_adjacent_triangles_overlap(
+            &p,
+            &q,
+            &r,
+            &p3(1., -1., 0.5)
+        ));
+        assert!(!edge_adjacent_triangles_overlap(
+            &p,
+            &q,
+            &r,
+            &p3(1., 0.5, 0.5)
+        ));
+        // Folded completely onto r's side: overlap.
+        assert!(edge_adjacent_triangles_overlap(
+            &p,
+            &q,
+            &r,
+            &p3(1.5, 3., 0.)
+        ));
+        assert!(edge_adjacent_triangles_overlap(
+            &q,
+            &p,
+            &r,
+            &p3(0.2, 0.1, 0.)
+        ));
+        // Tilted plane, folded.
+        assert!(edge_adjacent_triangles_overlap(
+            &p3(3., 0., 0.),
+            &p3(0., 3., 0.),
+            &p3(0., 0., 3.),
+            &p3(1., 1., 1.)
+        ));
+    }
+
+    #[test]
+    fn shared_vertex_meets_elsewhere_or_not() {
+        let v = p3(0., 0., 0.);
+        let (a, b) = (p3(2., 0., 0.), p3(0., 2., 0.));
+        // Fan neighbour in the same plane, no overlap.
+        assert!(!vertex_adjacent_triangles_intersect(
+            &v,
+            &a,
+            &b,
+            &p3(-2., 0., 0.),
+            &p3(0., -2., 0.)
+        ));
+        // Coplanar, overlapping the wedge.
+        assert!(vertex_adjacent_triangles_intersect(
+            &v,
+            &a,
+            &b,
+            &p3(1., 1., 0.),
+            &p3(2., 2., 0.)
+        ));
+        // Crossing through a's interior from above to below.
+        assert!(vertex_adjacent_triangles_intersect(
+            &v,
+            &a,
+            &b,
+            &p3(1., 1., 1.),
+            &p3(1., 1., -1.)
+        ));
+        // Above, leaning over without touching.
+        assert!(!vertex_adjacent_triangles_intersect(
+            &v,
+            &a,
+            &b,
+            &p3(1., 1., 1.),
+            &p3(2., 1., 1.)
+        ));
+    }
+
+    #[test]
+    fn triangles_intersect_is_exact_where_float_orient3d_fails() {
+        // a lies in the vertical plane y = x. b's corner P sits a few ulps off that plane; b's
+        // other corners are clearly on the y > x side, so b meets a iff P.y <= P.x. The plane
+        // side of P is decided exactly; the naive float determinant gets some of these wrong.
+        let a = tri((-12., -12., -10.), (24., 24., -10.), (0., 0., 10.));
+        let eps = f64::EPSILON;
+        let mut naive_wrong = 0;
+        for i in 0..32 {
+            for j in 0..32 {
+                let pt = p3(0.5 + i as f64 * eps, 0.5 + j as f64 * eps, 0.5);
+                let b = [pt, p3(0., 1., 0.5), p3(0., 1., 1.)];
+                let truth = pt.y <= pt.x;
+                assert_eq!(triangles_intersect(&a, &b), truth, "at {i},{j}");
+                assert_eq!(triangles_intersect(&b, &a), truth, "at {i},{j}");
+                let (u, v, w) = (a[0] - pt, a[1] - pt, a[2] - pt);
+                let naive = u.dot(&v.cross(&w));
+                let exact = orient3d(&a[0], &a[1], &a[2], &pt);
+                if Sign::of(naive) != exact {
+                    naive_wrong += 1;
+                }
+            }
+        }
+        assert!(
+            naive_wrong > 0,
+            "the naive determinant should fail somewhere on this grid"
+        );
+    }
+
+    #[test]
+    fn segments_in_3d() {
+        let (a, b) = (p3(0., 0., 0.), p3(2., 2., 2.));
+        assert!(segments_intersect_3d(
+            &a,
+            &b,
+            &p3(2., 0., 0.),
+            &p3(0., 2., 2.)
+        ));
+        assert!(!segments_intersect_3d(
+            &a,
+            &b,
+            &p3(2., 0., 0.),
+            &p3(0., 2., 3.)
+        ));
+        // Collinear overlap and collinear gap along a line parallel to no axis plane.
+        assert!(segments_intersect_3d(
+            &a,
+            &b,
+            &p3(1., 1., 1.),
+            &p3(3., 3., 3.)
+        ));
+        assert!(!segments_intersect_3d(
+            &a,
+            &b,
+            &p3(3., 3., 3.),
+            &p3(4., 4., 4.)
+        ));
+        // Parallel, coplanar, not collinear.
+        assert!(!segments_intersect_3d(
+            &a,
+            &b,
+            &p3(1., 0., 0.),
+            &p3(3., 2., 2.)
+        ));
     }
 
     #[test]

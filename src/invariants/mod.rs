@@ -5,6 +5,14 @@
 //! topology and boundary kept, flips against a reference surface), `disk.rs` (patches),
 //! `bijective.rs` (parameterizations), `planar.rs` (2D remeshing).
 
+pub mod mesh;
+
+pub use mesh::{
+    certify_boundary_preserved, certify_manifold, certify_no_degenerate_faces,
+    certify_no_self_intersections, certify_oriented, certify_same_topology, degenerate_faces,
+    faces_intersect, is_degenerate, non_manifold_vertices, self_intersections,
+};
+
 use crate::ids::{EdgeKey, FaceId, VertexId};
 use serde::Serialize;
 use std::fmt;

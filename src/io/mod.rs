@@ -1,14 +1,51 @@
 //! Mesh file formats: OBJ, OFF, PLY, STL, Medit `.mesh` (one file per format, reader and
 //! writer). Writers are atomic: a failure leaves no partial output file.
 //!
-//! The API below is the contract other modules build on; the format files implement it.
+//! Every reader works on the whole file in memory, never trusts a count from a header for an
+//! allocation (pre-allocation is capped by what the file's size can hold), and turns every
+//! malformed input into a typed [`IoError`] naming the file, the line (text formats) and the
+//! element. Readers build a [`TriMesh`] through its validating constructor; whether the mesh is
+//! manifold or consistently oriented is not the reader's business (that is `check`).
 
-use crate::mesh::TriMesh;
-use nalgebra::Point2;
+mod medit;
+mod obj;
+mod off;
+mod ply;
+mod stl;
+mod text;
+
+use crate::mesh::{MeshError, TriMesh};
+use nalgebra::{Point2, Point3};
+use std::io::Write;
 use std::path::Path;
 use thiserror::Error;
 
-/// Errors of reading and writing mesh files.
+/// At most 24 characters of a byte string, non-printable bytes shown as `?`.
+pub(crate) fn printable(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(&bytes[..bytes.len().min(24)])
+        .chars()
+        .map(|c| {
+            if c.is_ascii_graphic() || c == ' ' {
+                c
+            } else {
+                '?'
+            }
+        })
+        .collect()
+}
+
+/// " line N" for text formats, nothing for binary ones (line 0).
+fn loc(line: &usize) -> String {
+    if *line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
+}
+
+/// Errors of reading and writing mesh files. Each names the file and, where there is one,
+/// the line (`path:line:`) and the element (face or vertex number, 0-based as in the file's
+/// own order).
 #[derive(Debug, Error)]
 pub enum IoError {
     /// Operating-system error on a path.
@@ -25,6 +62,168 @@ pub enum IoError {
         /// the file
         path: String,
     },
+    /// The file holds nothing (zero bytes, or only whitespace and comments).
+    #[error("{path}: empty {format} file")]
+    Empty {
+        /// the file
+        path: String,
+        /// format name
+        format: &'static str,
+    },
+    /// The file does not start with the format's magic word.
+    #[error("{path}: wrong magic for {format} (file starts with {found:?})")]
+    BadMagic {
+        /// the file
+        path: String,
+        /// format name
+        format: &'static str,
+        /// what the file starts with (shortened)
+        found: String,
+    },
+    /// Malformed text or header.
+    #[error("{path}{}: {format} parse error: {message}", loc(.line))]
+    Parse {
+        /// the file
+        path: String,
+        /// format name
+        format: &'static str,
+        /// 1-based line (0 when the format is binary)
+        line: usize,
+        /// what is wrong
+        message: String,
+    },
+    /// The file ends before the data its header announced.
+    #[error("{path}: truncated {format} file: {message}")]
+    Truncated {
+        /// the file
+        path: String,
+        /// format name
+        format: &'static str,
+        /// what was expected and what was found
+        message: String,
+    },
+    /// A header claims more elements than a `u32` id can name (a file claiming more than it
+    /// can hold, but fewer than that, is [`IoError::Truncated`]).
+    #[error("{path}: {format} header claims {claimed} {what}, more than u32 ids can name (file has {file_bytes} bytes)")]
+    TooLarge {
+        /// the file
+        path: String,
+        /// format name
+        format: &'static str,
+        /// "vertices", "faces", ...
+        what: &'static str,
+        /// the claimed count
+        claimed: u64,
+        /// size of the file
+        file_bytes: u64,
+    },
+    /// A face refers to a vertex that does not exist (index as written in the file).
+    #[error("{path}{}: face {face} refers to vertex index {index}, but the file has {n_vertices} vertices", loc(.line))]
+    BadIndex {
+        /// the file
+        path: String,
+        /// 1-based line (0 for binary formats)
+        line: usize,
+        /// face number in the file (0-based)
+        face: usize,
+        /// the index as written (1-based for OBJ and Medit, may be negative)
+        index: i64,
+        /// number of vertices
+        n_vertices: usize,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("{path}{}: vertex {vertex} has a non-finite coordinate", loc(.line))]
+    NonFinite {
+        /// the file
+        path: String,
+        /// 1-based line (0 for binary formats)
+        line: usize,
+        /// vertex number in the file (0-based; for STL the facet corner 3·facet + k)
+        vertex: usize,
+    },
+    /// A face uses the same vertex twice.
+    #[error("{path}{}: face {face} repeats vertex {vertex}", loc(.line))]
+    RepeatedVertex {
+        /// the file
+        path: String,
+        /// 1-based line (0 for binary formats)
+        line: usize,
+        /// face number in the file (0-based)
+        face: usize,
+        /// the repeated vertex (0-based)
+        vertex: usize,
+    },
+    /// A PLY property type that the PLY format does not define.
+    #[error("{path}{}: PLY property `{property}` of element `{element}` has unknown type `{ty}`", loc(.line))]
+    UnknownProperty {
+        /// the file
+        path: String,
+        /// 1-based header line
+        line: usize,
+        /// element name
+        element: String,
+        /// property name
+        property: String,
+        /// the unknown type name
+        ty: String,
+    },
+    /// A variant of the format that conemesh does not read (named).
+    #[error("{path}: {format}: {what} is not supported")]
+    Unsupported {
+        /// the file
+        path: String,
+        /// format name
+        format: &'static str,
+        /// the unsupported feature
+        what: String,
+    },
+    /// The file holds no faces.
+    #[error("{path}: {format} file has no faces")]
+    NoFaces {
+        /// the file
+        path: String,
+        /// format name
+        format: &'static str,
+    },
+    /// Attributes handed to a writer do not match the mesh.
+    #[error("{path}: bad attribute: {message}")]
+    BadAttribute {
+        /// the file
+        path: String,
+        /// what does not match
+        message: String,
+    },
+    /// The mesh arrays are invalid (a writer refuses to write them).
+    #[error("{path}: {source}")]
+    Mesh {
+        /// the file
+        path: String,
+        /// the mesh error
+        source: MeshError,
+    },
+}
+
+impl IoError {
+    /// A short stable name of the error kind (used by the bad-input corpus table).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            IoError::Os { .. } => "os",
+            IoError::UnsupportedFormat { .. } => "unsupported-format",
+            IoError::Empty { .. } => "empty",
+            IoError::BadMagic { .. } => "bad-magic",
+            IoError::Parse { .. } => "parse",
+            IoError::Truncated { .. } => "truncated",
+            IoError::TooLarge { .. } => "too-large",
+            IoError::BadIndex { .. } => "bad-index",
+            IoError::NonFinite { .. } => "non-finite",
+            IoError::RepeatedVertex { .. } => "repeated-vertex",
+            IoError::UnknownProperty { .. } => "unknown-property",
+            IoError::Unsupported { .. } => "unsupported",
+            IoError::NoFaces { .. } => "no-faces",
+            IoError::BadAttribute { .. } => "bad-attribute",
+            IoError::Mesh { .. } => "mesh",
+        }
+    }
 }
 
 /// A mesh read from a file, with what the reader had to fix or skip.
@@ -38,11 +237,14 @@ pub struct LoadedMesh {
     pub welded_vertices: usize,
     /// Human-readable warnings (one line each).
     pub warnings: Vec<String>,
+    /// Attributes found in the file (OBJ `vt`, PLY `u v`, PLY integer face properties and
+    /// `red green blue`), per triangle after fan triangulation.
+    pub attributes: MeshAttributes,
 }
 
 /// Optional per-element data to write with a mesh (formats that cannot hold an attribute
 /// ignore it; PLY holds face properties and colours, OBJ holds `vt`).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshAttributes {
     /// Named integer properties per face (PLY `property int NAME`).
     pub face_ints: Vec<(String, Vec<i64>)>,
@@ -61,11 +263,57 @@ pub struct WriteOptions {
     pub big_endian: bool,
 }
 
+/// The supported formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Wavefront OBJ.
+    Obj,
+    /// Object File Format.
+    Off,
+    /// Stanford PLY.
+    Ply,
+    /// STL (stereolithography).
+    Stl,
+    /// Medit / INRIA `.mesh` (ASCII).
+    Medit,
+}
+
+impl Format {
+    /// The format named by a path's extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "obj" => Format::Obj,
+            "off" => Format::Off,
+            "ply" => Format::Ply,
+            "stl" => Format::Stl,
+            "mesh" => Format::Medit,
+            _ => return None,
+        })
+    }
+}
+
 /// Read a mesh, choosing the format by extension (`.obj`, `.off`, `.ply`, `.stl`, `.mesh`).
 pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
-    Err(IoError::UnsupportedFormat {
-        path: path.display().to_string(),
-    })
+    let p = path.display().to_string();
+    let format =
+        Format::from_path(path).ok_or_else(|| IoError::UnsupportedFormat { path: p.clone() })?;
+    let bytes = std::fs::read(path).map_err(|source| IoError::Os {
+        path: p.clone(),
+        source,
+    })?;
+    read_mesh_bytes(&bytes, format, &p)
+}
+
+/// Read a mesh from bytes in a given format; `path` only names the source in errors.
+pub fn read_mesh_bytes(bytes: &[u8], format: Format, path: &str) -> Result<LoadedMesh, IoError> {
+    match format {
+        Format::Obj => obj::read(bytes, path),
+        Format::Off => off::read(bytes, path),
+        Format::Ply => ply::read(bytes, path),
+        Format::Stl => stl::read(bytes, path),
+        Format::Medit => medit::read(bytes, path),
+    }
 }
 
 /// Write a mesh atomically, choosing the format by extension.
@@ -78,14 +326,275 @@ pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<(), IoError> {
     )
 }
 
-/// Write a mesh with attributes and encoding options, atomically.
+/// Write a mesh with attributes and encoding options, atomically: the bytes go to a temporary
+/// file in the target directory, which is renamed over `path` only once complete, so that a
+/// failure leaves no partial output. The mesh is validated first ([`TriMesh::validate`]).
+///
+/// Precision: text formats and binary PLY store `f64` exactly (text uses Rust's shortest
+/// round-trip `Display`); binary STL stores `f32` by definition of the format, so each
+/// coordinate is rounded to the nearest `f32`.
 pub fn write_mesh_with(
     path: &Path,
-    _mesh: &TriMesh,
-    _attrs: &MeshAttributes,
-    _opts: &WriteOptions,
+    mesh: &TriMesh,
+    attrs: &MeshAttributes,
+    opts: &WriteOptions,
 ) -> Result<(), IoError> {
-    Err(IoError::UnsupportedFormat {
-        path: path.display().to_string(),
+    let p = path.display().to_string();
+    let format =
+        Format::from_path(path).ok_or_else(|| IoError::UnsupportedFormat { path: p.clone() })?;
+    mesh.validate().map_err(|source| IoError::Mesh {
+        path: p.clone(),
+        source,
+    })?;
+    check_attributes(mesh, attrs, &p)?;
+    write_atomic(path, |w| match format {
+        Format::Obj => obj::write(w, mesh, attrs),
+        Format::Off => off::write(w, mesh),
+        Format::Ply => ply::write(w, mesh, attrs, opts),
+        Format::Stl => stl::write(w, mesh, opts),
+        Format::Medit => medit::write(w, mesh, attrs),
     })
 }
+
+fn check_attributes(mesh: &TriMesh, attrs: &MeshAttributes, path: &str) -> Result<(), IoError> {
+    let bad = |message: String| IoError::BadAttribute {
+        path: path.to_string(),
+        message,
+    };
+    for (name, vals) in &attrs.face_ints {
+        if vals.len() != mesh.n_faces() {
+            return Err(bad(format!(
+                "face property `{name}` has {} values for {} faces",
+                vals.len(),
+                mesh.n_faces()
+            )));
+        }
+        if name.is_empty() || name.contains(char::is_whitespace) {
+            return Err(bad(format!("face property name {name:?} is not one word")));
+        }
+    }
+    if let Some(c) = &attrs.face_colors {
+        if c.len() != mesh.n_faces() {
+            return Err(bad(format!(
+                "{} face colours for {} faces",
+                c.len(),
+                mesh.n_faces()
+            )));
+        }
+    }
+    if let Some(uv) = &attrs.uv {
+        if uv.len() != mesh.n_vertices() {
+            return Err(bad(format!(
+                "{} uv coordinates for {} vertices",
+                uv.len(),
+                mesh.n_vertices()
+            )));
+        }
+        if uv.iter().any(|q| !(q.x.is_finite() && q.y.is_finite())) {
+            return Err(bad("non-finite uv coordinate".into()));
+        }
+    }
+    Ok(())
+}
+
+/// Write through `body` into a temporary file beside `path`, then rename it to `path`.
+/// On any error the temporary file is removed (dropped) and `path` is left untouched.
+fn write_atomic(
+    path: &Path,
+    body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), IoError> {
+    let p = path.display().to_string();
+    let os = |source: std::io::Error| IoError::Os {
+        path: p.clone(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".conemesh-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(os)?;
+    {
+        let mut w = std::io::BufWriter::new(tmp.as_file_mut());
+        body(&mut w).map_err(os)?;
+        w.flush().map_err(os)?;
+    }
+    tmp.as_file().sync_all().map_err(os)?;
+    #[cfg(unix)]
+    {
+        // tempfile creates 0600; give the result the usual permissions of a new file.
+        use std::os::unix::fs::PermissionsExt;
+        let _ = tmp
+            .as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    tmp.persist(path).map_err(|e| os(e.error))?;
+    Ok(())
+}
+
+/// Faces as read from a file, before triangulation: flat 0-based indices, one entry per face
+/// with its start offset and its line (0 for binary formats).
+#[derive(Default)]
+pub(crate) struct RawFaces {
+    idx: Vec<i64>,
+    start: Vec<usize>,
+    line: Vec<usize>,
+    /// Index as written (for messages), when it differs from the 0-based one (OBJ, Medit).
+    base: i64,
+}
+
+impl RawFaces {
+    pub(crate) fn with_capacity(faces: usize, base: i64) -> Self {
+        RawFaces {
+            idx: Vec::with_capacity(faces.saturating_mul(3)),
+            start: Vec::with_capacity(faces),
+            line: Vec::with_capacity(faces),
+            base,
+        }
+    }
+    pub(crate) fn begin(&mut self, line: usize) {
+        self.start.push(self.idx.len());
+        self.line.push(line);
+    }
+    pub(crate) fn push(&mut self, i: i64) {
+        self.idx.push(i);
+    }
+    pub(crate) fn len(&self) -> usize {
+        self.start.len()
+    }
+    fn face(&self, f: usize) -> &[i64] {
+        let end = self.start.get(f + 1).copied().unwrap_or(self.idx.len());
+        &self.idx[self.start[f]..end]
+    }
+}
+
+/// Check indices, fan-triangulate polygons and build the validated [`TriMesh`]. Returns the
+/// mesh, the number of polygons triangulated, and for each triangle the face it came from.
+pub(crate) fn build_mesh(
+    path: &str,
+    format: &'static str,
+    positions: Vec<Point3<f64>>,
+    faces: &RawFaces,
+) -> Result<(TriMesh, usize, Vec<usize>), IoError> {
+    let n = positions.len();
+    if faces.len() == 0 {
+        return Err(IoError::NoFaces {
+            path: path.to_string(),
+            format,
+        });
+    }
+    let mut tris: Vec<[usize; 3]> = Vec::with_capacity(faces.len());
+    let mut origin = Vec::with_capacity(faces.len());
+    let mut polygons = 0;
+    for f in 0..faces.len() {
+        let poly = faces.face(f);
+        let line = faces.line[f];
+        if poly.len() < 3 {
+            return Err(IoError::Parse {
+                path: path.to_string(),
+                format,
+                line,
+                message: format!("face {f} has {} vertices (at least 3 needed)", poly.len()),
+            });
+        }
+        for &i in poly {
+            if i < 0 || i as u64 >= n as u64 {
+                return Err(IoError::BadIndex {
+                    path: path.to_string(),
+                    line,
+                    face: f,
+                    index: i.saturating_add(faces.base),
+                    n_vertices: n,
+                });
+            }
+        }
+        for (k, &i) in poly.iter().enumerate() {
+            if poly[..k].contains(&i) {
+                return Err(IoError::RepeatedVertex {
+                    path: path.to_string(),
+                    line,
+                    face: f,
+                    vertex: i as usize,
+                });
+            }
+        }
+        if poly.len() > 3 {
+            polygons += 1;
+        }
+        // Fan triangulation around the first corner keeps the polygon's orientation.
+        for k in 1..poly.len() - 1 {
+            tris.push([poly[0] as usize, poly[k] as usize, poly[k + 1] as usize]);
+            origin.push(f);
+        }
+    }
+    let mesh = TriMesh::from_indices(positions, &tris).map_err(|source| IoError::Mesh {
+        path: path.to_string(),
+        source,
+    })?;
+    Ok((mesh, polygons, origin))
+}
+
+/// The number of elements to pre-allocate for a header claiming `claimed` elements of at
+/// least `min_bytes` bytes each, when `available` bytes remain: never more than fits.
+pub(crate) fn capped(claimed: u64, available: usize, min_bytes: usize) -> usize {
+    (claimed.min((available / min_bytes.max(1)) as u64)) as usize
+}
+
+/// Refuse a claimed count that a `u32` id cannot name ([`IoError::TooLarge`]) or that the
+/// file cannot hold at `min_bytes` per element ([`IoError::Truncated`]), before anything is
+/// allocated for it.
+pub(crate) fn check_claim(
+    path: &str,
+    format: &'static str,
+    what: &'static str,
+    claimed: u64,
+    min_bytes: u64,
+    file_bytes: usize,
+) -> Result<(), IoError> {
+    if claimed > u32::MAX as u64 {
+        return Err(IoError::TooLarge {
+            path: path.to_string(),
+            format,
+            what,
+            claimed,
+            file_bytes: file_bytes as u64,
+        });
+    }
+    if claimed.saturating_mul(min_bytes) > file_bytes as u64 {
+        return Err(IoError::Truncated {
+            path: path.to_string(),
+            format,
+            message: format!(
+                "header claims {claimed} {what}, more than the file's {file_bytes} bytes can hold"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Per-vertex uv from per-corner `(vertex, uv)` pairs, when every vertex gets one uv only
+/// (vertices no face uses get the origin). `None` when a vertex has two different uvs (a seam
+/// that a per-vertex attribute cannot hold).
+pub(crate) fn uv_per_vertex(
+    n_vertices: usize,
+    corners: &[(usize, Point2<f64>)],
+) -> Option<Vec<Point2<f64>>> {
+    let mut uv: Vec<Option<Point2<f64>>> = vec![None; n_vertices];
+    for &(v, t) in corners {
+        match uv.get(v)? {
+            Some(old) if *old != t => return None,
+            _ => uv[v] = Some(t),
+        }
+    }
+    Some(
+        uv.into_iter()
+            .map(|o| o.unwrap_or(Point2::origin()))
+            .collect(),
+    )
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,197 @@
+//! Write → read round trips of every format and encoding on random small meshes: positions
+//! bit-exact and the same triangles (OBJ, OFF, PLY ascii / binary LE / binary BE, Medit,
+//! ASCII STL after welding); binary STL equal to the `f32`-rounded, welded mesh. PLY also
+//! returns its face properties, colours and uv; OBJ its uv.
+
+use conemesh::io::{read_mesh, write_mesh_with, MeshAttributes, WriteOptions};
+use conemesh::mesh::generators;
+use conemesh::{TriMesh, VertexId};
+use nalgebra::{Point2, Point3};
+use proptest::prelude::*;
+use proptest::test_runner::FileFailurePersistence;
+use rand::{Rng as _, SeedableRng};
+use std::collections::HashMap;
+
+const CASES: u32 = 32;
+
+fn config() -> ProptestConfig {
+    ProptestConfig {
+        cases: CASES,
+        failure_persistence: Some(Box::new(FileFailurePersistence::Direct(
+            "proptests/regressions/io.txt",
+        ))),
+        ..Default::default()
+    }
+}
+
+/// A small generated surface, perturbed and scaled by `10^scale` (seeded).
+fn surface(kind: u8, seed: u64, scale: i32) -> TriMesh {
+    let base = match kind % 5 {
+        0 => generators::icosphere(1.0, 1),
+        1 => generators::torus(1.0, 0.3, 8, 5),
+        2 => generators::cylinder(1.0, 2.0, 7, 3),
+        3 => generators::disk(1.0, 3, 6),
+        _ => generators::genus_plate(1, 2),
+    };
+    let mut rng = conemesh::Rng::seed_from_u64(seed);
+    let mut m = generators::perturb(&base, 0.01, &mut rng);
+    let s = 10f64.powi(scale);
+    for p in &mut m.positions {
+        *p = Point3::from(p.coords * s);
+    }
+    m
+}
+
+fn bits(m: &TriMesh) -> Vec<[u64; 3]> {
+    m.positions
+        .iter()
+        .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+        .collect()
+}
+
+/// What an STL round trip must give: corners in facet order, rounded by `round`, welded at
+/// their first occurrence (`-0.0` equal to `0.0`).
+fn stl_expected(m: &TriMesh, round: impl Fn(f64) -> f64) -> TriMesh {
+    let mut map: HashMap<[u64; 3], usize> = HashMap::new();
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for t in &m.triangles {
+        let mut nt = [VertexId(0); 3];
+        for (k, v) in t.iter().enumerate() {
+            let p = m.positions[v.idx()].map(&round);
+            let key = [p.x, p.y, p.z].map(|x| (x + 0.0).to_bits());
+            let i = *map.entry(key).or_insert_with(|| {
+                positions.push(p);
+                positions.len() - 1
+            });
+            nt[k] = VertexId::new(i);
+        }
+        triangles.push(nt);
+    }
+    TriMesh {
+        positions,
+        triangles,
+    }
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn every_format_round_trips(kind in 0u8..5, seed in any::<u64>(), scale in -8i32..8,
+                                wild in proptest::collection::vec((any::<u64>(), 0usize..1000, 0usize..3), 0..4)) {
+        let mut m = surface(kind, seed, scale);
+        // Arbitrary finite doubles (subnormals, huge, negative zero) must survive text too.
+        for (b, v, k) in wild {
+            let x = f64::from_bits(b);
+            if x.is_finite() {
+                let v = v % m.n_vertices();
+                m.positions[v][k] = x;
+            }
+        }
+        let mut rng = conemesh::Rng::seed_from_u64(seed ^ 0x5eed);
+        let attrs = MeshAttributes {
+            face_ints: vec![("patch".into(), (0..m.n_faces()).map(|_| rng.random_range(-9..1000)).collect())],
+            face_colors: Some((0..m.n_faces()).map(|_| [rng.random(), rng.random(), rng.random()]).collect()),
+            uv: Some((0..m.n_vertices()).map(|_| Point2::new(rng.random(), rng.random())).collect()),
+        };
+        let dir = tempfile::tempdir().expect("tempdir");
+        for (name, binary, big_endian) in [
+            ("m.obj", false, false), ("m.off", false, false), ("m.mesh", false, false),
+            ("a.ply", false, false), ("le.ply", true, false), ("be.ply", true, true),
+        ] {
+            let path = dir.path().join(name);
+            write_mesh_with(&path, &m, &attrs, &WriteOptions { binary, big_endian })
+                .map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let back = read_mesh(&path).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            prop_assert_eq!(bits(&back.mesh), bits(&m), "{}", name);
+            prop_assert_eq!(&back.mesh.triangles, &m.triangles, "{}", name);
+            if name.ends_with(".ply") {
+                prop_assert_eq!(&back.attributes, &attrs, "{}", name);
+            }
+            if name.ends_with(".obj") {
+                prop_assert_eq!(&back.attributes.uv, &attrs.uv, "{}", name);
+            }
+        }
+    }
+
+    #[test]
+    fn stl_round_trips_after_welding(kind in 0u8..5, seed in any::<u64>(), scale in -8i32..8) {
+        let m = surface(kind, seed, scale);
+        let dir = tempfile::tempdir().expect("tempdir");
+        for binary in [false, true] {
+            let path = dir.path().join(if binary { "b.stl" } else { "a.stl" });
+            write_mesh_with(&path, &m, &MeshAttributes::default(), &WriteOptions { binary, big_endian: false })
+                .map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let back = read_mesh(&path).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            // Binary STL holds f32: exactly the nearest-f32 rounding, nothing more.
+            let expected = if binary {
+                stl_expected(&m, |x| x as f32 as f64)
+            } else {
+                stl_expected(&m, |x| x)
+            };
+            prop_assert_eq!(bits(&back.mesh), bits(&expected), "binary {}", binary);
+            prop_assert_eq!(&back.mesh.triangles, &expected.triangles);
+            prop_assert_eq!(back.welded_vertices, 3 * m.n_faces() - expected.n_vertices());
+        }
+    }
+}
+
+/// Valid files of every format and encoding, for mutation (written once).
+fn valid_files() -> &'static [(conemesh::io::Format, Vec<u8>)] {
+    static FILES: std::sync::OnceLock<Vec<(conemesh::io::Format, Vec<u8>)>> =
+        std::sync::OnceLock::new();
+    FILES.get_or_init(write_valid_files)
+}
+
+fn write_valid_files() -> Vec<(conemesh::io::Format, Vec<u8>)> {
+    use conemesh::io::Format;
+    let m = surface(0, 1, 0);
+    let attrs = MeshAttributes {
+        face_ints: vec![("patch".into(), vec![1; m.n_faces()])],
+        face_colors: Some(vec![[1, 2, 3]; m.n_faces()]),
+        uv: Some(vec![Point2::new(0.5, 0.5); m.n_vertices()]),
+    };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut out = Vec::new();
+    for (name, f, binary, big_endian) in [
+        ("m.obj", Format::Obj, false, false),
+        ("m.off", Format::Off, false, false),
+        ("m.mesh", Format::Medit, false, false),
+        ("a.ply", Format::Ply, false, false),
+        ("le.ply", Format::Ply, true, false),
+        ("be.ply", Format::Ply, true, true),
+        ("a.stl", Format::Stl, false, false),
+        ("b.stl", Format::Stl, true, false),
+    ] {
+        let path = dir.path().join(name);
+        write_mesh_with(&path, &m, &attrs, &WriteOptions { binary, big_endian }).expect("write");
+        out.push((f, std::fs::read(&path).expect("read back")));
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..config() })]
+
+    /// Readers never panic: random byte edits and truncations of valid files either read or
+    /// give a typed error.
+    #[test]
+    fn mutated_files_never_panic(which in 0usize..8,
+                                 edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 0..6),
+                                 cut in any::<prop::sample::Index>(), do_cut in any::<bool>()) {
+        let files = valid_files();
+        let (format, mut bytes) = files[which].clone();
+        for (at, b) in edits {
+            let i = at.index(bytes.len());
+            bytes[i] = b;
+        }
+        if do_cut {
+            bytes.truncate(cut.index(bytes.len() + 1));
+        }
+        let r = conemesh::io::read_mesh_bytes(&bytes, format, "fuzz");
+        if let Err(e) = r {
+            prop_assert!(e.to_string().starts_with("fuzz"));
+        }
+    }
+}

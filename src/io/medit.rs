@@ -1,0 +1,184 @@
+//! Medit / INRIA `.mesh` (ASCII): `MeshVersionFormatted`, `Dimension`, then sections
+//! `KEYWORD count records…` until `End`. `Vertices` (x y z ref, or x y ref in 2D, read with
+//! z = 0) and `Triangles` (a b c ref, 1-based) are read, `Quadrilaterals` fan-triangulated;
+//! every other known section is skipped by its record size. Triangle references are kept as
+//! the face attribute `ref` when any is non-zero, and written from the first face attribute.
+
+use super::text::{as_text, count, float, int, short, Tokens};
+use super::{build_mesh, check_claim, IoError, LoadedMesh, MeshAttributes, RawFaces};
+use crate::mesh::TriMesh;
+use nalgebra::Point3;
+use std::io::Write;
+
+const F: &str = "Medit";
+
+/// Tokens per record of a section in dimension `d`; `None` for an unknown keyword.
+fn record_tokens(key: &str, d: usize) -> Option<usize> {
+    Some(match key {
+        "vertices" => d + 1,
+        "edges" => 3,
+        "triangles" => 4,
+        "quadrilaterals" | "tetrahedra" => 5,
+        "pyramids" => 6,
+        "prisms" => 7,
+        "hexahedra" => 9,
+        "corners"
+        | "ridges"
+        | "requiredvertices"
+        | "requirededges"
+        | "requiredtriangles"
+        | "requiredquadrilaterals"
+        | "requiredtetrahedra" => 1,
+        "normals" | "tangents" => d,
+        "normalatvertices" => 2,
+        "normalattrianglevertices"
+        | "normalatquadrilateralvertices"
+        | "tangentatedgevertices"
+        | "normalatedgevertices" => 3,
+        _ => return None,
+    })
+}
+
+pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
+    let text = as_text(bytes, path, F)?;
+    let mut t = Tokens::new(text);
+    let parse = |line: usize, message: String| IoError::Parse {
+        path: path.to_string(),
+        format: F,
+        line,
+        message,
+    };
+    let trunc = |what: &str, line: usize| IoError::Truncated {
+        path: path.to_string(),
+        format: F,
+        message: format!("file ends inside {what} (line {line})"),
+    };
+    let Some((l0, first)) = t.next() else {
+        return Err(IoError::Empty {
+            path: path.to_string(),
+            format: F,
+        });
+    };
+    if !first.eq_ignore_ascii_case("MeshVersionFormatted") {
+        return Err(IoError::BadMagic {
+            path: path.to_string(),
+            format: F,
+            found: super::printable(first.as_bytes()),
+        });
+    }
+    let _version = match t.next() {
+        Some((l, tok)) => int(tok, l, path, F)?,
+        None => return Err(trunc("the header", l0)),
+    };
+    let mut dim = 3;
+    let mut positions: Vec<Point3<f64>> = Vec::new();
+    let mut faces = RawFaces::with_capacity(0, 1);
+    let mut refs: Vec<i64> = Vec::new();
+    let mut warnings = Vec::new();
+    while let Some((l, tok)) = t.next() {
+        let key = tok.to_ascii_lowercase();
+        if key == "end" {
+            break;
+        }
+        if key == "dimension" {
+            let (dl, d) = t.next().ok_or_else(|| trunc("`Dimension`", l))?;
+            dim = match int(d, dl, path, F)? {
+                2 => 2,
+                3 => 3,
+                d => return Err(parse(dl, format!("dimension {d} (2 or 3 expected)"))),
+            };
+            continue;
+        }
+        let Some(k) = record_tokens(&key, dim) else {
+            return Err(parse(l, format!("unknown section `{}`", short(tok))));
+        };
+        let (cl, c) = t.next().ok_or_else(|| trunc(tok, l))?;
+        let n = count(c, cl, path, F)?;
+        // Each record takes at least k tokens of 2 bytes.
+        check_claim(path, F, "records", n, 2 * k as u64, bytes.len() + 1)?;
+        let mut rec = [""; 9];
+        for i in 0..n as usize {
+            for slot in rec.iter_mut().take(k) {
+                *slot = t.next().ok_or_else(|| trunc(tok, t.last_line))?.1;
+            }
+            let rl = t.last_line;
+            match key.as_str() {
+                "vertices" => {
+                    let mut p = Point3::origin();
+                    for j in 0..dim {
+                        p[j] = float(rec[j], rl, path, F)?;
+                    }
+                    if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+                        return Err(IoError::NonFinite {
+                            path: path.to_string(),
+                            line: rl,
+                            vertex: positions.len(),
+                        });
+                    }
+                    positions.push(p);
+                }
+                "triangles" | "quadrilaterals" => {
+                    faces.begin(rl);
+                    for r in &rec[..k - 1] {
+                        // 1-based in the file.
+                        faces.push(int(r, rl, path, F)?.saturating_sub(1));
+                    }
+                    refs.push(int(rec[k - 1], rl, path, F)?);
+                }
+                _ => {
+                    let _ = i;
+                }
+            }
+        }
+        if !matches!(key.as_str(), "vertices" | "triangles" | "quadrilaterals") {
+            warnings.push(format!("{path}: section `{tok}` skipped"));
+        }
+    }
+    let (mesh, polygons, origin) = build_mesh(path, F, positions, &faces)?;
+    if polygons > 0 {
+        warnings.push(format!(
+            "{path}: {polygons} quadrilaterals fan-triangulated"
+        ));
+    }
+    let mut attributes = MeshAttributes::default();
+    if refs.iter().any(|&r| r != 0) {
+        let r: Option<Vec<i64>> = origin.iter().map(|&f| refs.get(f).copied()).collect();
+        if let Some(r) = r {
+            attributes.face_ints.push(("ref".into(), r));
+        }
+    }
+    Ok(LoadedMesh {
+        mesh,
+        polygons_triangulated: polygons,
+        welded_vertices: 0,
+        warnings,
+        attributes,
+    })
+}
+
+pub(super) fn write(
+    w: &mut dyn Write,
+    mesh: &TriMesh,
+    attrs: &MeshAttributes,
+) -> std::io::Result<()> {
+    writeln!(w, "MeshVersionFormatted 2\nDimension 3\n")?;
+    writeln!(w, "Vertices\n{}", mesh.n_vertices())?;
+    for p in &mesh.positions {
+        // `{:?}` of f64 is the shortest text that parses back to the same bits.
+        writeln!(w, "{:?} {:?} {:?} 0", p.x, p.y, p.z)?;
+    }
+    writeln!(w, "\nTriangles\n{}", mesh.n_faces())?;
+    let refs = attrs.face_ints.first().map(|(_, v)| v);
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        let r = refs.and_then(|v| v.get(f)).copied().unwrap_or(0);
+        writeln!(
+            w,
+            "{} {} {} {r}",
+            t[0].0 as u64 + 1,
+            t[1].0 as u64 + 1,
+            t[2].0 as u64 + 1
+        )?;
+    }
+    writeln!(w, "\nEnd")?;
+    Ok(())
+}

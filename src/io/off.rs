@@ -1,0 +1,162 @@
+//! OFF (Object File Format): `OFF`, counts `V F E`, V vertex lines, F face lines `n i1 … in`.
+//! Variants `COFF`, `NOFF`, `STOFF`, … carry extra per-vertex values, which are skipped
+//! (each vertex and face is one line). Binary OFF and 4D/nD OFF are refused by name.
+
+use super::text::{as_text, count, float, int};
+use super::{build_mesh, check_claim, IoError, LoadedMesh, RawFaces};
+use crate::mesh::TriMesh;
+use nalgebra::Point3;
+use std::io::Write;
+
+const F: &str = "OFF";
+
+pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
+    let text = as_text(bytes, path, F)?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.split('#').next().unwrap_or("").trim()))
+        .filter(|(_, l)| !l.is_empty());
+    let Some((_, first)) = lines.next() else {
+        return Err(IoError::Empty {
+            path: path.to_string(),
+            format: F,
+        });
+    };
+    let mut head = first.split_ascii_whitespace();
+    let magic = head.next().unwrap_or("");
+    let prefix = magic.strip_suffix("OFF");
+    let Some(prefix) = prefix.filter(|p| p.chars().all(|c| "STCN4n".contains(c))) else {
+        return Err(IoError::BadMagic {
+            path: path.to_string(),
+            format: F,
+            found: super::printable(first.as_bytes()),
+        });
+    };
+    if prefix.contains('4') || prefix.contains('n') {
+        return Err(IoError::Unsupported {
+            path: path.to_string(),
+            format: F,
+            what: format!("`{magic}` (vertices not in 3D)"),
+        });
+    }
+    let mut rest: Vec<&str> = head.collect();
+    if rest.first() == Some(&"BINARY") {
+        return Err(IoError::Unsupported {
+            path: path.to_string(),
+            format: F,
+            what: "binary OFF".into(),
+        });
+    }
+    let mut count_line = 1;
+    if rest.is_empty() {
+        let Some((l, s)) = lines.next() else {
+            return Err(IoError::Truncated {
+                path: path.to_string(),
+                format: F,
+                message: "no counts line after the header".into(),
+            });
+        };
+        count_line = l;
+        rest = s.split_ascii_whitespace().collect();
+    }
+    if rest.len() < 2 {
+        return Err(IoError::Parse {
+            path: path.to_string(),
+            format: F,
+            line: count_line,
+            message: "expected the counts `V F E`".into(),
+        });
+    }
+    let nv = count(rest[0], count_line, path, F)?;
+    let nf = count(rest[1], count_line, path, F)?;
+    // Each vertex line needs at least "0 0 0" (5 bytes), each face "3 0 1 2" (7 bytes).
+    check_claim(path, F, "vertices", nv, 5, bytes.len())?;
+    check_claim(path, F, "faces", nf, 7, bytes.len())?;
+    let mut positions = Vec::with_capacity(nv as usize);
+    for i in 0..nv as usize {
+        let Some((l, s)) = lines.next() else {
+            return Err(IoError::Truncated {
+                path: path.to_string(),
+                format: F,
+                message: format!("header claims {nv} vertices, file ends after {i}"),
+            });
+        };
+        let t: Vec<&str> = s.split_ascii_whitespace().take(3).collect();
+        if t.len() < 3 {
+            return Err(IoError::Parse {
+                path: path.to_string(),
+                format: F,
+                line: l,
+                message: format!("vertex {i} has {} coordinates, 3 needed", t.len()),
+            });
+        }
+        let p = Point3::new(
+            float(t[0], l, path, F)?,
+            float(t[1], l, path, F)?,
+            float(t[2], l, path, F)?,
+        );
+        if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+            return Err(IoError::NonFinite {
+                path: path.to_string(),
+                line: l,
+                vertex: i,
+            });
+        }
+        positions.push(p);
+    }
+    let mut faces = RawFaces::with_capacity(nf as usize, 0);
+    for f in 0..nf as usize {
+        let Some((l, s)) = lines.next() else {
+            return Err(IoError::Truncated {
+                path: path.to_string(),
+                format: F,
+                message: format!("header claims {nf} faces, file ends after {f}"),
+            });
+        };
+        let mut t = s.split_ascii_whitespace();
+        let k = count(t.next().unwrap_or(""), l, path, F)?;
+        faces.begin(l);
+        let mut got = 0u64;
+        for tok in t.by_ref().take(k.min(u32::MAX as u64) as usize) {
+            faces.push(int(tok, l, path, F)?);
+            got += 1;
+        }
+        if got < k {
+            return Err(IoError::Parse {
+                path: path.to_string(),
+                format: F,
+                line: l,
+                message: format!("face {f} announces {k} vertices but lists {got}"),
+            });
+        }
+    }
+    let mut warnings = Vec::new();
+    if let Some((l, _)) = lines.next() {
+        warnings.push(format!("{path}:{l}: data after the last face ignored"));
+    }
+    let (mesh, polygons, _) = build_mesh(path, F, positions, &faces)?;
+    if polygons > 0 {
+        warnings.push(format!("{path}: {polygons} polygon faces fan-triangulated"));
+    }
+    Ok(LoadedMesh {
+        mesh,
+        polygons_triangulated: polygons,
+        welded_vertices: 0,
+        warnings,
+        attributes: Default::default(),
+    })
+}
+
+pub(super) fn write(w: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> {
+    writeln!(w, "OFF")?;
+    writeln!(w, "{} {} 0", mesh.n_vertices(), mesh.n_faces())?;
+    for p in &mesh.positions {
+        // `{:?}` of f64 is the shortest text that parses back to the same bits.
+        writeln!(w, "{:?} {:?} {:?}", p.x, p.y, p.z)?;
+    }
+    for t in &mesh.triangles {
+        writeln!(w, "3 {} {} {}", t[0].0, t[1].0, t[2].0)?;
+    }
+    Ok(())
+}

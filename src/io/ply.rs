@@ -1,0 +1,772 @@
+//! Stanford PLY: `ascii`, `binary_little_endian` and `binary_big_endian`.
+//!
+//! Read: element `vertex` with scalar `x y z` of any numeric type (optional `u v`, `s t` or
+//! `texture_u texture_v`); element `face` with a list `vertex_indices` (or `vertex_index`) of
+//! any integer count and index types, its scalar integer properties (kept as face attributes,
+//! `red green blue` as colours); element `tristrips` (strips separated by `-1`, decoded with
+//! alternating orientation). Every other element and property is skipped by its declared type.
+//! Write: `double x y z` (bit-exact), optional `double u v`, `list uchar int vertex_indices`,
+//! optional `int NAME` face properties and `uchar red green blue`.
+
+use super::text::{as_text, short, Tokens};
+use super::{
+    build_mesh, capped, check_claim, IoError, LoadedMesh, MeshAttributes, RawFaces, WriteOptions,
+};
+use crate::mesh::TriMesh;
+use nalgebra::{Point2, Point3};
+use std::io::Write;
+
+const F: &str = "PLY";
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ty {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Ty {
+    fn parse(s: &str) -> Option<Ty> {
+        Some(match s {
+            "char" | "int8" => Ty::I8,
+            "uchar" | "uint8" => Ty::U8,
+            "short" | "int16" => Ty::I16,
+            "ushort" | "uint16" => Ty::U16,
+            "int" | "int32" => Ty::I32,
+            "uint" | "uint32" => Ty::U32,
+            "float" | "float32" => Ty::F32,
+            "double" | "float64" => Ty::F64,
+            _ => return None,
+        })
+    }
+    fn size(self) -> usize {
+        match self {
+            Ty::I8 | Ty::U8 => 1,
+            Ty::I16 | Ty::U16 => 2,
+            Ty::I32 | Ty::U32 | Ty::F32 => 4,
+            Ty::F64 => 8,
+        }
+    }
+    fn is_int(self) -> bool {
+        !matches!(self, Ty::F32 | Ty::F64)
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Num {
+    I(i64),
+    F(f64),
+}
+
+impl Num {
+    fn f64(self) -> f64 {
+        match self {
+            Num::I(i) => i as f64,
+            Num::F(x) => x,
+        }
+    }
+}
+
+#[derive(Debug)]
+struct Prop {
+    name: String,
+    /// `Some(count type)` for a list property.
+    list: Option<Ty>,
+    ty: Ty,
+}
+
+#[derive(Debug)]
+struct Element {
+    name: String,
+    count: u64,
+    props: Vec<Prop>,
+}
+
+impl Element {
+    /// The least number of bytes one element can take in the body.
+    fn min_bytes(&self, ascii: bool) -> u64 {
+        self.props
+            .iter()
+            .map(|p| match (ascii, p.list) {
+                (true, _) => 2,
+                (false, Some(c)) => c.size() as u64,
+                (false, None) => p.ty.size() as u64,
+            })
+            .sum()
+    }
+    fn find(&self, names: &[&str]) -> Option<usize> {
+        self.props
+            .iter()
+            .position(|p| p.list.is_none() && names.contains(&p.name.as_str()))
+    }
+}
+
+/// The body, ASCII tokens or binary bytes.
+enum Body<'a> {
+    Ascii(Tokens<'a>),
+    Binary {
+        data: &'a [u8],
+        pos: usize,
+        big_endian: bool,
+    },
+}
+
+struct Reader<'a, 'p> {
+    body: Body<'a>,
+    path: &'p str,
+}
+
+impl Reader<'_, '_> {
+    fn line(&self) -> usize {
+        match &self.body {
+            Body::Ascii(t) => t.last_line,
+            Body::Binary { .. } => 0,
+        }
+    }
+
+    fn remaining(&self) -> usize {
+        match &self.body {
+            Body::Ascii(_) => usize::MAX,
+            Body::Binary { data, pos, .. } => data.len() - pos,
+        }
+    }
+
+    fn truncated(&self, el: &Element, i: u64) -> IoError {
+        IoError::Truncated {
+            path: self.path.to_string(),
+            format: F,
+            message: format!(
+                "file ends inside element `{}` {i} of {} (header claims {})",
+                el.name, el.count, el.count
+            ),
+        }
+    }
+
+    fn scalar(&mut self, ty: Ty, el: &Element, i: u64) -> Result<Num, IoError> {
+        match &mut self.body {
+            Body::Ascii(t) => {
+                let Some((line, tok)) = t.next() else {
+                    return Err(self.truncated(el, i));
+                };
+                let bad = |what: &str| IoError::Parse {
+                    path: self.path.to_string(),
+                    format: F,
+                    line,
+                    message: format!(
+                        "element `{}` {i}: expected {what}, found `{}`",
+                        el.name,
+                        short(tok)
+                    ),
+                };
+                if ty.is_int() {
+                    tok.parse::<i64>()
+                        .map(Num::I)
+                        .map_err(|_| bad("an integer"))
+                } else {
+                    tok.parse::<f64>().map(Num::F).map_err(|_| bad("a number"))
+                }
+            }
+            Body::Binary {
+                data,
+                pos,
+                big_endian,
+            } => {
+                let n = ty.size();
+                let Some(b) = data.get(*pos..*pos + n) else {
+                    return Err(self.truncated(el, i));
+                };
+                *pos += n;
+                let mut a = [0u8; 8];
+                a[..n].copy_from_slice(b);
+                if *big_endian {
+                    a[..n].reverse();
+                }
+                Ok(match ty {
+                    Ty::I8 => Num::I(a[0] as i8 as i64),
+                    Ty::U8 => Num::I(a[0] as i64),
+                    Ty::I16 => Num::I(i16::from_le_bytes([a[0], a[1]]) as i64),
+                    Ty::U16 => Num::I(u16::from_le_bytes([a[0], a[1]]) as i64),
+                    Ty::I32 => Num::I(i32::from_le_bytes([a[0], a[1], a[2], a[3]]) as i64),
+                    Ty::U32 => Num::I(u32::from_le_bytes([a[0], a[1], a[2], a[3]]) as i64),
+                    Ty::F32 => Num::F(f32::from_le_bytes([a[0], a[1], a[2], a[3]]) as f64),
+                    Ty::F64 => Num::F(f64::from_le_bytes(a)),
+                })
+            }
+        }
+    }
+
+    /// A list's length, checked against what the rest of the file can hold.
+    fn list_len(&mut self, p: &Prop, count_ty: Ty, el: &Element, i: u64) -> Result<usize, IoError> {
+        // Count types are integers (checked in the header); a float cannot arrive here.
+        let n = match self.scalar(count_ty, el, i)? {
+            Num::I(n) => n,
+            Num::F(x) => x as i64,
+        };
+        let line = self.line();
+        if n < 0 {
+            return Err(IoError::Parse {
+                path: self.path.to_string(),
+                format: F,
+                line,
+                message: format!(
+                    "element `{}` {i}: list `{}` has length {n}",
+                    el.name, p.name
+                ),
+            });
+        }
+        let n = n as u64;
+        if n.saturating_mul(p.ty.size() as u64) > self.remaining() as u64 {
+            return Err(self.truncated(el, i));
+        }
+        Ok(n as usize)
+    }
+}
+
+struct Header {
+    elements: Vec<Element>,
+    format: Option<(bool, bool)>, // (binary, big endian)
+    body_start: usize,
+    body_first_line: usize,
+}
+
+fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
+    let err = |line: usize, message: String| IoError::Parse {
+        path: path.to_string(),
+        format: F,
+        line,
+        message,
+    };
+    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(IoError::Empty {
+            path: path.to_string(),
+            format: F,
+        });
+    }
+    let first_end = bytes
+        .iter()
+        .position(|&b| b == b'\n')
+        .unwrap_or(bytes.len());
+    let first = &bytes[..first_end];
+    if first.strip_suffix(b"\r").unwrap_or(first) != b"ply" {
+        return Err(IoError::BadMagic {
+            path: path.to_string(),
+            format: F,
+            found: super::printable(&bytes[..first_end]),
+        });
+    }
+    // The header ends at the line `end_header`; the body starts after its newline.
+    let mut pos = 0;
+    let mut line_no = 0;
+    let mut lines = Vec::new();
+    let body_start = loop {
+        if pos >= bytes.len() {
+            return Err(IoError::Truncated {
+                path: path.to_string(),
+                format: F,
+                message: "header has no `end_header` line".into(),
+            });
+        }
+        let end = bytes[pos..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |k| pos + k);
+        line_no += 1;
+        let raw = &bytes[pos..end];
+        let text = std::str::from_utf8(raw)
+            .map_err(|_| err(line_no, "header line is not text".into()))?
+            .trim_end_matches('\r');
+        pos = (end + 1).min(bytes.len());
+        if text.trim() == "end_header" {
+            break pos;
+        }
+        lines.push((line_no, text));
+    };
+    let mut h = Header {
+        elements: Vec::new(),
+        format: None,
+        body_start,
+        body_first_line: line_no + 1,
+    };
+    for &(l, text) in lines.iter().skip(1) {
+        let t: Vec<&str> = text.split_ascii_whitespace().collect();
+        match t.first().copied() {
+            None | Some("comment") | Some("obj_info") => {}
+            Some("format") => {
+                h.format = Some(match t.get(1).copied() {
+                    Some("ascii") => (false, false),
+                    Some("binary_little_endian") => (true, false),
+                    Some("binary_big_endian") => (true, true),
+                    other => {
+                        return Err(err(
+                            l,
+                            format!("unknown format `{}`", short(other.unwrap_or(""))),
+                        ))
+                    }
+                });
+            }
+            Some("element") => {
+                if t.len() != 3 {
+                    return Err(err(l, "expected `element NAME COUNT`".into()));
+                }
+                let count = t[2]
+                    .parse::<u64>()
+                    .map_err(|_| err(l, format!("bad element count `{}`", short(t[2]))))?;
+                h.elements.push(Element {
+                    name: t[1].to_string(),
+                    count,
+                    props: Vec::new(),
+                });
+            }
+            Some("property") => {
+                let Some(el) = h.elements.last_mut() else {
+                    return Err(err(l, "property before any element".into()));
+                };
+                let unknown = |ty: &str, name: &str| IoError::UnknownProperty {
+                    path: path.to_string(),
+                    line: l,
+                    element: el.name.clone(),
+                    property: name.to_string(),
+                    ty: short(ty),
+                };
+                let prop = if t.get(1) == Some(&"list") {
+                    if t.len() != 5 {
+                        return Err(err(
+                            l,
+                            "expected `property list COUNT_TYPE TYPE NAME`".into(),
+                        ));
+                    }
+                    let ct = Ty::parse(t[2]).ok_or_else(|| unknown(t[2], t[4]))?;
+                    let ty = Ty::parse(t[3]).ok_or_else(|| unknown(t[3], t[4]))?;
+                    if !ct.is_int() {
+                        return Err(err(
+                            l,
+                            format!("list `{}` has non-integer count type `{}`", t[4], t[2]),
+                        ));
+                    }
+                    Prop {
+                        name: t[4].to_string(),
+                        list: Some(ct),
+                        ty,
+                    }
+                } else {
+                    if t.len() != 3 {
+                        return Err(err(l, "expected `property TYPE NAME`".into()));
+                    }
+                    Prop {
+                        name: t[2].to_string(),
+                        list: None,
+                        ty: Ty::parse(t[1]).ok_or_else(|| unknown(t[1], t[2]))?,
+                    }
+                };
+                el.props.push(prop);
+            }
+            Some(k) => return Err(err(l, format!("unknown header keyword `{}`", short(k)))),
+        }
+    }
+    if h.format.is_none() {
+        return Err(err(2, "no `format` line".into()));
+    }
+    Ok(h)
+}
+
+/// Per-element roles of the properties the reader keeps.
+struct FaceRoles {
+    list: usize,
+    ints: Vec<usize>,
+    rgb: Option<[usize; 3]>,
+}
+
+pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
+    let h = parse_header(bytes, path)?;
+    let (binary, big_endian) = h.format.unwrap_or((false, false));
+    let body_bytes = &bytes[h.body_start..];
+    let body = if binary {
+        Body::Binary {
+            data: body_bytes,
+            pos: 0,
+            big_endian,
+        }
+    } else {
+        Body::Ascii(Tokens::starting_at(
+            as_text(body_bytes, path, F).map_err(|e| match e {
+                IoError::Parse {
+                    path,
+                    format,
+                    line,
+                    message,
+                } => IoError::Parse {
+                    path,
+                    format,
+                    line: line + h.body_first_line - 1,
+                    message,
+                },
+                e => e,
+            })?,
+            h.body_first_line,
+        ))
+    };
+    for el in &h.elements {
+        // +1: the last ASCII token needs no separator after it.
+        check_claim(
+            path,
+            F,
+            "elements",
+            el.count,
+            el.min_bytes(!binary),
+            body_bytes.len() + 1,
+        )?;
+    }
+    let parse_err = |message: String| IoError::Parse {
+        path: path.to_string(),
+        format: F,
+        line: 0,
+        message,
+    };
+    let mut rd = Reader { body, path };
+    let mut positions: Vec<Point3<f64>> = Vec::new();
+    let mut uv: Option<Vec<Point2<f64>>> = None;
+    let mut faces = RawFaces::with_capacity(0, 0);
+    let mut face_ints: Vec<(String, Vec<i64>)> = Vec::new();
+    let mut colors: Option<Vec<[u8; 3]>> = None;
+    let mut saw_vertex = false;
+    let mut saw_faces = false;
+    let mut warnings = Vec::new();
+    let mut vals: Vec<Num> = Vec::new();
+    let mut list: Vec<i64> = Vec::new();
+    for el in &h.elements {
+        let n = el.count;
+        match el.name.as_str() {
+            "vertex" => {
+                saw_vertex = true;
+                let xyz = [el.find(&["x"]), el.find(&["y"]), el.find(&["z"])];
+                let [Some(x), Some(y), Some(z)] = xyz else {
+                    return Err(parse_err("element `vertex` lacks scalar x, y or z".into()));
+                };
+                let uvp = el
+                    .find(&["u", "s", "texture_u"])
+                    .zip(el.find(&["v", "t", "texture_v"]));
+                positions.reserve(capped(n, rd.remaining(), el.min_bytes(!binary) as usize));
+                if uvp.is_some() {
+                    uv = Some(Vec::with_capacity(positions.capacity()));
+                }
+                for i in 0..n {
+                    read_element(&mut rd, el, i, &mut vals, &mut list)?;
+                    let p = Point3::new(vals[x].f64(), vals[y].f64(), vals[z].f64());
+                    if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+                        return Err(IoError::NonFinite {
+                            path: path.to_string(),
+                            line: rd.line(),
+                            vertex: i as usize,
+                        });
+                    }
+                    positions.push(p);
+                    if let (Some((u, v)), Some(uv)) = (uvp, uv.as_mut()) {
+                        uv.push(Point2::new(vals[u].f64(), vals[v].f64()));
+                    }
+                }
+            }
+            "face" => {
+                saw_faces = true;
+                let Some(li) = el.props.iter().position(|p| {
+                    p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index")
+                }) else {
+                    return Err(IoError::Unsupported {
+                        path: path.to_string(),
+                        format: F,
+                        what: "element `face` without a `vertex_indices` list".into(),
+                    });
+                };
+                if !el.props[li].ty.is_int() {
+                    return Err(parse_err(format!(
+                        "face list `{}` has non-integer index type",
+                        el.props[li].name
+                    )));
+                }
+                let int_scalar = |name: &str| {
+                    el.props
+                        .iter()
+                        .position(|p| p.list.is_none() && p.ty.is_int() && p.name == name)
+                };
+                let rgb = match (int_scalar("red"), int_scalar("green"), int_scalar("blue")) {
+                    (Some(r), Some(g), Some(b)) => Some([r, g, b]),
+                    _ => None,
+                };
+                let ints: Vec<usize> = (0..el.props.len())
+                    .filter(|&k| {
+                        let p = &el.props[k];
+                        p.list.is_none() && p.ty.is_int() && !rgb.is_some_and(|c| c.contains(&k))
+                    })
+                    .collect();
+                let roles = FaceRoles {
+                    list: li,
+                    ints,
+                    rgb,
+                };
+                let cap = capped(n, rd.remaining(), el.min_bytes(!binary) as usize);
+                face_ints = roles
+                    .ints
+                    .iter()
+                    .map(|&k| (el.props[k].name.clone(), Vec::with_capacity(cap)))
+                    .collect();
+                if roles.rgb.is_some() {
+                    colors = Some(Vec::with_capacity(cap));
+                }
+                for i in 0..n {
+                    read_element_face(&mut rd, el, i, &roles, &mut vals, &mut list)?;
+                    faces.begin(rd.line());
+                    for &v in &list {
+                        faces.push(v);
+                    }
+                    for (slot, &k) in face_ints.iter_mut().zip(&roles.ints) {
+                        if let Num::I(v) = vals[k] {
+                            slot.1.push(v);
+                        }
+                    }
+                    if let (Some([r, g, b]), Some(c)) = (roles.rgb, colors.as_mut()) {
+                        let u = |k: usize| match vals[k] {
+                            Num::I(v) => v.clamp(0, 255) as u8,
+                            Num::F(_) => 0,
+                        };
+                        c.push([u(r), u(g), u(b)]);
+                    }
+                }
+            }
+            "tristrips" => {
+                saw_faces = true;
+                let Some(li) = el
+                    .props
+                    .iter()
+                    .position(|p| p.list.is_some() && p.name == "vertex_indices")
+                else {
+                    return Err(IoError::Unsupported {
+                        path: path.to_string(),
+                        format: F,
+                        what: "element `tristrips` without a `vertex_indices` list".into(),
+                    });
+                };
+                let roles = FaceRoles {
+                    list: li,
+                    ints: Vec::new(),
+                    rgb: None,
+                };
+                for i in 0..n {
+                    read_element_face(&mut rd, el, i, &roles, &mut vals, &mut list)?;
+                    decode_strips(&list, rd.line(), &mut faces);
+                }
+                warnings.push(format!("{path}: triangle strips decoded"));
+            }
+            _ => {
+                if !el.props.is_empty() {
+                    for i in 0..n {
+                        read_element(&mut rd, el, i, &mut vals, &mut list)?;
+                    }
+                }
+                warnings.push(format!("{path}: PLY element `{}` skipped", el.name));
+            }
+        }
+    }
+    if !saw_vertex {
+        return Err(parse_err("no `vertex` element".into()));
+    }
+    if !saw_faces {
+        return Err(IoError::NoFaces {
+            path: path.to_string(),
+            format: F,
+        });
+    }
+    let n_v = positions.len();
+    let (mesh, polygons, origin) = build_mesh(path, F, positions, &faces)?;
+    if polygons > 0 {
+        warnings.push(format!("{path}: {polygons} polygon faces fan-triangulated"));
+    }
+    // Face attributes follow their face into each of its triangles (tristrips carry none).
+    let spread =
+        |v: &Vec<i64>| -> Option<Vec<i64>> { origin.iter().map(|&f| v.get(f).copied()).collect() };
+    let attributes = MeshAttributes {
+        face_ints: face_ints
+            .iter()
+            .filter_map(|(name, v)| Some((name.clone(), spread(v)?)))
+            .collect(),
+        face_colors: colors.and_then(|c| origin.iter().map(|&f| c.get(f).copied()).collect()),
+        uv: uv.filter(|u| u.len() == n_v),
+    };
+    Ok(LoadedMesh {
+        mesh,
+        polygons_triangulated: polygons,
+        welded_vertices: 0,
+        warnings,
+        attributes,
+    })
+}
+
+/// Read one element: scalars into `vals` (lists are skipped, `vals` gets a placeholder).
+fn read_element(
+    rd: &mut Reader,
+    el: &Element,
+    i: u64,
+    vals: &mut Vec<Num>,
+    list: &mut Vec<i64>,
+) -> Result<(), IoError> {
+    vals.clear();
+    for p in &el.props {
+        match p.list {
+            None => vals.push(rd.scalar(p.ty, el, i)?),
+            Some(ct) => {
+                let k = rd.list_len(p, ct, el, i)?;
+                list.clear();
+                for _ in 0..k {
+                    rd.scalar(p.ty, el, i)?;
+                }
+                vals.push(Num::I(k as i64));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Read one face-like element: scalars into `vals`, the index list `roles.list` into `list`.
+fn read_element_face(
+    rd: &mut Reader,
+    el: &Element,
+    i: u64,
+    roles: &FaceRoles,
+    vals: &mut Vec<Num>,
+    list: &mut Vec<i64>,
+) -> Result<(), IoError> {
+    vals.clear();
+    for (k, p) in el.props.iter().enumerate() {
+        match p.list {
+            None => vals.push(rd.scalar(p.ty, el, i)?),
+            Some(ct) => {
+                let n = rd.list_len(p, ct, el, i)?;
+                if k == roles.list {
+                    list.clear();
+                    for _ in 0..n {
+                        if let Num::I(v) = rd.scalar(p.ty, el, i)? {
+                            list.push(v);
+                        }
+                    }
+                } else {
+                    for _ in 0..n {
+                        rd.scalar(p.ty, el, i)?;
+                    }
+                }
+                vals.push(Num::I(n as i64));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Triangle strips: `-1` ends a strip; triangle k of a strip is `(s[k], s[k+1], s[k+2])`,
+/// with odd k reversed so that all triangles share the strip's orientation. Triangles with a
+/// repeated vertex are the strips' usual joins and are dropped.
+fn decode_strips(list: &[i64], line: usize, faces: &mut RawFaces) {
+    for strip in list.split(|&v| v < 0) {
+        for k in 0..strip.len().saturating_sub(2) {
+            let (a, b, c) = (strip[k], strip[k + 1], strip[k + 2]);
+            if a == b || b == c || a == c {
+                continue;
+            }
+            faces.begin(line);
+            if k % 2 == 0 {
+                faces.push(a);
+                faces.push(b);
+            } else {
+                faces.push(b);
+                faces.push(a);
+            }
+            faces.push(c);
+        }
+    }
+}
+
+pub(super) fn write(
+    w: &mut dyn Write,
+    mesh: &TriMesh,
+    attrs: &MeshAttributes,
+    opts: &WriteOptions,
+) -> std::io::Result<()> {
+    let enc = match (opts.binary, opts.big_endian) {
+        (false, _) => "ascii",
+        (true, false) => "binary_little_endian",
+        (true, true) => "binary_big_endian",
+    };
+    writeln!(w, "ply\nformat {enc} 1.0\ncomment written by conemesh")?;
+    writeln!(w, "element vertex {}", mesh.n_vertices())?;
+    writeln!(w, "property double x\nproperty double y\nproperty double z")?;
+    if attrs.uv.is_some() {
+        writeln!(w, "property double u\nproperty double v")?;
+    }
+    writeln!(w, "element face {}", mesh.n_faces())?;
+    writeln!(w, "property list uchar int vertex_indices")?;
+    for (name, _) in &attrs.face_ints {
+        writeln!(w, "property int {name}")?;
+    }
+    if attrs.face_colors.is_some() {
+        writeln!(
+            w,
+            "property uchar red\nproperty uchar green\nproperty uchar blue"
+        )?;
+    }
+    writeln!(w, "end_header")?;
+    let int = |v: i64| {
+        i32::try_from(v).map_err(|_| {
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("face property value {v} does not fit a PLY int"),
+            )
+        })
+    };
+    if !opts.binary {
+        for (i, p) in mesh.positions.iter().enumerate() {
+            // `{:?}` of f64 is the shortest text that parses back to the same bits.
+            write!(w, "{:?} {:?} {:?}", p.x, p.y, p.z)?;
+            if let Some(uv) = &attrs.uv {
+                write!(w, " {:?} {:?}", uv[i].x, uv[i].y)?;
+            }
+            writeln!(w)?;
+        }
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            write!(w, "3 {} {} {}", t[0].0, t[1].0, t[2].0)?;
+            for (_, v) in &attrs.face_ints {
+                write!(w, " {}", int(v[f])?)?;
+            }
+            if let Some(c) = &attrs.face_colors {
+                write!(w, " {} {} {}", c[f][0], c[f][1], c[f][2])?;
+            }
+            writeln!(w)?;
+        }
+        return Ok(());
+    }
+    let be = opts.big_endian;
+    let f64b = |x: f64| if be { x.to_be_bytes() } else { x.to_le_bytes() };
+    let i32b = |x: i32| if be { x.to_be_bytes() } else { x.to_le_bytes() };
+    for (i, p) in mesh.positions.iter().enumerate() {
+        for x in [p.x, p.y, p.z] {
+            w.write_all(&f64b(x))?;
+        }
+        if let Some(uv) = &attrs.uv {
+            w.write_all(&f64b(uv[i].x))?;
+            w.write_all(&f64b(uv[i].y))?;
+        }
+    }
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        w.write_all(&[3])?;
+        for v in t {
+            w.write_all(&i32b(int(v.0 as i64)?))?;
+        }
+        for (_, v) in &attrs.face_ints {
+            w.write_all(&i32b(int(v[f])?))?;
+        }
+        if let Some(c) = &attrs.face_colors {
+            w.write_all(&c[f])?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,445 @@
+//! Unit tests of the readers and writers on small inline files.
+
+use super::*;
+use crate::ids::VertexId;
+
+fn rd(text: &str, f: Format) -> Result<LoadedMesh, IoError> {
+    read_mesh_bytes(text.as_bytes(), f, "t")
+}
+
+#[test]
+fn off_reads_quad_as_two_triangles_keeping_orientation() -> Result<(), IoError> {
+    let m = rd(
+        "OFF\n# comment\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n",
+        Format::Off,
+    )?;
+    assert_eq!(m.mesh.n_vertices(), 4);
+    assert_eq!(m.mesh.n_faces(), 2);
+    assert_eq!(m.polygons_triangulated, 1);
+    for f in m.mesh.faces() {
+        assert!(m.mesh.face_normal(f).z > 0.0);
+    }
+    Ok(())
+}
+
+#[test]
+fn off_counts_on_magic_line_and_coff_extras() -> Result<(), IoError> {
+    let m = rd(
+        "COFF 3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2 9 9 9\n",
+        Format::Off,
+    )?;
+    assert_eq!(m.mesh.n_faces(), 1);
+    Ok(())
+}
+
+#[test]
+fn off_errors_are_named() {
+    let e = rd("OFF\n3 1 0\n0 0 0\n1 0 0\n", Format::Off).unwrap_err();
+    assert_eq!(e.kind(), "truncated", "{e}");
+    let e = rd("OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n", Format::Off).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::NonFinite {
+                vertex: 1,
+                line: 4,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = rd("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", Format::Off).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::BadIndex {
+                face: 0,
+                index: 7,
+                n_vertices: 3,
+                line: 6,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert_eq!(
+        e.to_string(),
+        "t:6: face 0 refers to vertex index 7, but the file has 3 vertices"
+    );
+    let e = rd("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1\n", Format::Off).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::RepeatedVertex {
+                face: 0,
+                vertex: 1,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = rd("OFF\n1000000000000 1 0\n0 0 0\n", Format::Off).unwrap_err();
+    assert_eq!(e.kind(), "too-large", "{e}");
+    assert_eq!(rd("", Format::Off).unwrap_err().kind(), "empty");
+    assert_eq!(rd("PLY\n", Format::Off).unwrap_err().kind(), "bad-magic");
+}
+
+#[test]
+fn obj_reads_all_face_forms_and_relative_indices() -> Result<(), IoError> {
+    let m = rd(
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\ng x\ns off\nusemtl m\n\
+         f 1/1/1 2//1 3\nf -4 -2 -1\n",
+        Format::Obj,
+    )?;
+    assert_eq!(m.mesh.n_faces(), 2);
+    assert_eq!(m.mesh.triangles[1], [VertexId(0), VertexId(2), VertexId(3)]);
+    let e = rd("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", Format::Obj).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::BadIndex {
+                index: 0,
+                line: 4,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = rd("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 1 2\n", Format::Obj).unwrap_err();
+    assert!(matches!(e, IoError::BadIndex { index: -4, .. }), "{e}");
+    let e = rd("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", Format::Obj).unwrap_err();
+    assert!(matches!(e, IoError::BadIndex { index: 4, .. }), "{e}");
+    let e = rd("v 0 0 0\nv 1 0 0\n", Format::Obj).unwrap_err();
+    assert_eq!(e.kind(), "no-faces");
+    let e = rd("v 0 0 0\nv 1 inf 0\n", Format::Obj).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::NonFinite {
+                vertex: 1,
+                line: 2,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = read_mesh_bytes(b"v 0 0 0\n\x00\xff\xfe", Format::Obj, "t").unwrap_err();
+    assert!(matches!(e, IoError::Parse { line: 2, .. }), "{e}");
+    Ok(())
+}
+
+#[test]
+fn obj_keeps_uv_when_one_per_vertex() -> Result<(), IoError> {
+    let m = rd(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.25\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+        Format::Obj,
+    )?;
+    let uv = m.attributes.uv.expect("uv kept");
+    assert_eq!(uv[0], Point2::new(0.5, 0.25));
+    Ok(())
+}
+
+/// The shared test meshes read with the vertex and face counts of their README.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
+fn shared_meshes_read_with_expected_counts() -> Result<(), IoError> {
+    let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"));
+    let table = [
+        ("3holes.off", 3596, 7200),
+        ("screwdriver.off", 3395, 6786),
+        ("fertility.off", 4494, 9000),
+        ("bunny.off", 3485, 6966),
+        ("fandisk.off", 7229, 14454),
+        ("cow.off", 2762, 5520),
+        ("bumpy.off", 1250, 2496),
+        ("decimated-knight.off", 502, 1000),
+        ("spot.obj", 2930, 5856),
+        ("homer.obj", 6002, 12000),
+        ("stanford-bunny.obj", 35947, 69451),
+        ("armadillo.obj", 43243, 86482),
+    ];
+    for (name, nv, nf) in table {
+        let m = read_mesh(&dir.join(name))?;
+        assert_eq!((m.mesh.n_vertices(), m.mesh.n_faces()), (nv, nf), "{name}");
+    }
+    Ok(())
+}
+
+/// A binary PLY with float x y z, an extra `ushort` vertex property and an extra face list,
+/// a `ushort`-counted `vertex_index` list of `uint`, and an unknown element in between.
+fn binary_ply(big_endian: bool) -> Vec<u8> {
+    let mut b = format!(
+        "ply\nformat {} 1.0\ncomment c\nelement vertex 4\nproperty float x\nproperty ushort junk\n\
+         property float y\nproperty float z\nelement edge 1\nproperty int a\nproperty int b\n\
+         element face 1\nproperty list uchar short other\nproperty list ushort uint vertex_index\n\
+         property uchar red\nproperty uchar green\nproperty uchar blue\nproperty int patch\nend_header\n",
+        if big_endian { "binary_big_endian" } else { "binary_little_endian" }
+    )
+    .into_bytes();
+    let f32b = |x: f32| {
+        if big_endian {
+            x.to_be_bytes()
+        } else {
+            x.to_le_bytes()
+        }
+    };
+    for (x, y, z) in [
+        (0.0, 0.0, 0.0),
+        (1.0, 0.0, 0.0),
+        (1.0, 1.0, 0.0),
+        (0.0, 1.0, 0.5),
+    ] {
+        b.extend(f32b(x));
+        b.extend(if big_endian {
+            7u16.to_be_bytes()
+        } else {
+            7u16.to_le_bytes()
+        });
+        b.extend(f32b(y));
+        b.extend(f32b(z));
+    }
+    b.extend([0u8; 8]); // the edge
+    b.push(2);
+    b.extend([0u8; 4]); // `other`: two shorts
+    b.extend(if big_endian {
+        4u16.to_be_bytes()
+    } else {
+        4u16.to_le_bytes()
+    });
+    for i in 0u32..4 {
+        b.extend(if big_endian {
+            i.to_be_bytes()
+        } else {
+            i.to_le_bytes()
+        });
+    }
+    b.extend([10, 20, 30]);
+    b.extend(if big_endian {
+        (-5i32).to_be_bytes()
+    } else {
+        (-5i32).to_le_bytes()
+    });
+    b
+}
+
+#[test]
+fn ply_binary_both_endiannesses_skip_unknown_properties() -> Result<(), IoError> {
+    for be in [false, true] {
+        let m = read_mesh_bytes(&binary_ply(be), Format::Ply, "t")?;
+        assert_eq!(m.mesh.n_vertices(), 4);
+        assert_eq!(m.mesh.n_faces(), 2);
+        assert_eq!(m.polygons_triangulated, 1);
+        assert_eq!(m.mesh.positions[3], Point3::new(0.0, 1.0, 0.5));
+        assert_eq!(m.attributes.face_colors, Some(vec![[10, 20, 30]; 2]));
+        assert_eq!(
+            m.attributes.face_ints,
+            vec![("patch".to_string(), vec![-5, -5])]
+        );
+    }
+    let mut cut = binary_ply(false);
+    cut.truncate(cut.len() - 9);
+    let e = read_mesh_bytes(&cut, Format::Ply, "t").unwrap_err();
+    assert_eq!(e.kind(), "truncated", "{e}");
+    Ok(())
+}
+
+#[test]
+fn ply_ascii_tristrips_and_header_errors() -> Result<(), IoError> {
+    let m = rd(
+        "ply\nformat ascii 1.0\nelement vertex 5\nproperty double x\nproperty double y\n\
+         property double z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n\
+         0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n6 0 1 2 3 -1 4\n",
+        Format::Ply,
+    )?;
+    assert_eq!(m.mesh.n_faces(), 2);
+    // Strip triangles share one orientation.
+    for f in m.mesh.faces() {
+        assert!(m.mesh.face_normal_raw(f).z > 0.0);
+    }
+    let hdr = |extra: &str| {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n\
+             property double z\n{extra}end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+        )
+    };
+    let e = rd(
+        &hdr("element face 1\nproperty list uchar int128 vertex_indices\n"),
+        Format::Ply,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(&e, IoError::UnknownProperty { ty, .. } if ty == "int128"),
+        "{e}"
+    );
+    let e = rd(
+        &hdr("element face 1\nproperty list float int vertex_indices\n"),
+        Format::Ply,
+    )
+    .unwrap_err();
+    assert_eq!(e.kind(), "parse", "{e}");
+    let e = rd(
+        &hdr("element face 1\nproperty list uchar int vertex_indices\n")
+            .replace("0 1 2\n", "0 1 9\n"),
+        Format::Ply,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::BadIndex {
+                index: 9,
+                line: 13,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = rd(
+        &hdr("element face 1000000000000\nproperty list uchar int vertex_indices\n"),
+        Format::Ply,
+    )
+    .unwrap_err();
+    assert_eq!(e.kind(), "too-large", "{e}");
+    Ok(())
+}
+
+#[test]
+fn stl_ascii_and_binary_weld_corners() -> Result<(), IoError> {
+    let ascii =
+        "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n\
+                 endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\n\
+                 vertex -0 1 0\nendloop\nendfacet\nendsolid x\n";
+    let m = rd(ascii, Format::Stl)?;
+    assert_eq!(
+        (m.mesh.n_vertices(), m.mesh.n_faces(), m.welded_vertices),
+        (4, 2, 2)
+    );
+    let e = rd(&ascii[..ascii.len() - 30], Format::Stl).unwrap_err();
+    assert_eq!(e.kind(), "truncated", "{e}");
+    let e = rd(
+        &ascii.replace("vertex 1 1 0", "vertex 1 NaN 0"),
+        Format::Stl,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::NonFinite {
+                vertex: 4,
+                line: 12,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    Ok(())
+}
+
+#[test]
+fn medit_reads_and_skips_sections() -> Result<(), IoError> {
+    let m = rd(
+        "MeshVersionFormatted 2\nDimension\n3\nVertices\n4\n0 0 0 1\n1 0 0 1\n1 1 0 1\n0 1 0 1\n\
+         Edges\n1\n1 2 0\nTriangles\n1\n1 2 3 7\nQuadrilaterals\n1\n1 2 3 4 0\nCorners\n1\n1\nEnd\n",
+        Format::Medit,
+    )?;
+    assert_eq!(m.mesh.n_faces(), 3);
+    assert_eq!(
+        m.attributes.face_ints,
+        vec![("ref".to_string(), vec![7, 0, 0])]
+    );
+    let e = rd("MeshVersionFormatted 2\nDimension 3\nVertices\n3\n0 0 0 0\n1 0 0 0\n0 1 0 0\nTriangles\n1\n0 1 2 0\nEnd\n", Format::Medit).unwrap_err();
+    assert!(matches!(e, IoError::BadIndex { index: 0, .. }), "{e}");
+    Ok(())
+}
+
+fn sample() -> TriMesh {
+    let mut rng = <crate::Rng as rand::SeedableRng>::seed_from_u64(7);
+    let mut m = crate::mesh::generators::perturb(
+        &crate::mesh::generators::icosphere(1.0, 1),
+        0.1,
+        &mut rng,
+    );
+    m.positions[0].x = -0.0;
+    m.positions[1].y = 1e-300;
+    m.positions[2].z = 1.0 / 3.0;
+    m
+}
+
+#[test]
+fn writers_round_trip_bit_exact() -> Result<(), IoError> {
+    let dir = tempfile::tempdir().map_err(|source| IoError::Os {
+        path: "tmp".into(),
+        source,
+    })?;
+    let m = sample();
+    let n = m.n_faces();
+    let attrs = MeshAttributes {
+        face_ints: vec![("patch".into(), (0..n as i64).map(|i| i - 3).collect())],
+        face_colors: Some((0..n).map(|i| [i as u8, 2, 255]).collect()),
+        uv: Some(
+            m.positions
+                .iter()
+                .map(|p| Point2::new(p.x, p.y * 0.5))
+                .collect(),
+        ),
+    };
+    for (name, binary, big_endian) in [
+        ("a.obj", false, false),
+        ("a.off", false, false),
+        ("a.mesh", false, false),
+        ("a.ply", false, false),
+        ("b.ply", true, false),
+        ("c.ply", true, true),
+        ("a.stl", false, false),
+    ] {
+        let p = dir.path().join(name);
+        write_mesh_with(&p, &m, &attrs, &WriteOptions { binary, big_endian })?;
+        let back = read_mesh(&p)?;
+        if name.ends_with(".stl") {
+            assert_eq!(back.mesh.n_faces(), n);
+            assert_eq!(back.welded_vertices, 3 * n - m.n_vertices());
+            continue;
+        }
+        let bits = |t: &TriMesh| -> Vec<[u64; 3]> {
+            t.positions
+                .iter()
+                .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+                .collect()
+        };
+        assert_eq!(bits(&back.mesh), bits(&m), "{name}");
+        assert_eq!(back.mesh.triangles, m.triangles, "{name}");
+        if name.ends_with(".ply") {
+            assert_eq!(back.attributes, attrs, "{name}");
+        }
+        if name.ends_with(".obj") {
+            assert_eq!(back.attributes.uv, attrs.uv, "{name}");
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn failed_write_leaves_no_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = dir.path().join("x.ply");
+    let mut m = sample();
+    let attrs = MeshAttributes {
+        face_ints: vec![("big".into(), vec![i64::MAX; m.n_faces()])],
+        ..Default::default()
+    };
+    let e = write_mesh_with(&p, &m, &attrs, &WriteOptions::default()).unwrap_err();
+    assert_eq!(e.kind(), "os", "{e}");
+    m.positions[3].x = f64::NAN;
+    let e = write_mesh(&dir.path().join("y.obj"), &m).unwrap_err();
+    assert_eq!(e.kind(), "mesh", "{e}");
+    let left: Vec<_> = std::fs::read_dir(dir.path()).expect("dir").collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+#[test]
+fn utf8_byte_order_mark_is_skipped() -> Result<(), IoError> {
+    let m = rd("\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Format::Obj)?;
+    assert_eq!(m.mesh.n_vertices(), 3);
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+    Ok(())
+}

@@ -1,0 +1,125 @@
+//! Shared helpers of the text formats: UTF-8 check, tokens with line numbers, numbers.
+
+use super::IoError;
+
+/// The file as text, or a parse error naming the line of the first byte that is not text
+/// (binary garbage with a text extension).
+pub(crate) fn as_text<'a>(
+    bytes: &'a [u8],
+    path: &str,
+    format: &'static str,
+) -> Result<&'a str, IoError> {
+    let bad_at = match std::str::from_utf8(bytes) {
+        Ok(s) => match s.find('\0') {
+            // A UTF-8 byte-order mark is not part of the first keyword.
+            None => return Ok(s.strip_prefix('\u{feff}').unwrap_or(s)),
+            Some(i) => i,
+        },
+        Err(e) => e.valid_up_to(),
+    };
+    let line = 1 + bytes[..bad_at].iter().filter(|&&b| b == b'\n').count();
+    Err(IoError::Parse {
+        path: path.to_string(),
+        format,
+        line,
+        message: format!("binary data (byte {bad_at} is not text)"),
+    })
+}
+
+/// Whitespace-separated tokens with their 1-based line, `#` comments removed.
+pub(crate) struct Tokens<'a> {
+    lines: std::iter::Enumerate<std::str::Lines<'a>>,
+    cur: std::str::SplitAsciiWhitespace<'a>,
+    line: usize,
+    /// Line of the last token returned (or of the end of the file).
+    pub(crate) last_line: usize,
+    first: usize,
+}
+
+impl<'a> Tokens<'a> {
+    pub(crate) fn new(text: &'a str) -> Self {
+        Self::starting_at(text, 1)
+    }
+
+    /// Tokens of `text` whose first line is line `first` of the file.
+    pub(crate) fn starting_at(text: &'a str, first: usize) -> Self {
+        Tokens {
+            lines: text.lines().enumerate(),
+            cur: "".split_ascii_whitespace(),
+            line: first.saturating_sub(1),
+            last_line: first.saturating_sub(1),
+            first,
+        }
+    }
+}
+
+impl<'a> Iterator for Tokens<'a> {
+    type Item = (usize, &'a str);
+    fn next(&mut self) -> Option<(usize, &'a str)> {
+        loop {
+            if let Some(t) = self.cur.next() {
+                self.last_line = self.line;
+                return Some((self.line, t));
+            }
+            let (i, l) = self.lines.next()?;
+            self.line = i + self.first;
+            self.last_line = self.line;
+            let l = l.split('#').next().unwrap_or("");
+            self.cur = l.split_ascii_whitespace();
+        }
+    }
+}
+
+/// Parse a float token (NaN and infinities parse; the caller rejects them by vertex).
+pub(crate) fn float(
+    tok: &str,
+    line: usize,
+    path: &str,
+    format: &'static str,
+) -> Result<f64, IoError> {
+    tok.parse::<f64>().map_err(|_| IoError::Parse {
+        path: path.to_string(),
+        format,
+        line,
+        message: format!("expected a number, found `{}`", short(tok)),
+    })
+}
+
+/// Parse an integer token.
+pub(crate) fn int(
+    tok: &str,
+    line: usize,
+    path: &str,
+    format: &'static str,
+) -> Result<i64, IoError> {
+    tok.parse::<i64>().map_err(|_| IoError::Parse {
+        path: path.to_string(),
+        format,
+        line,
+        message: format!("expected an integer, found `{}`", short(tok)),
+    })
+}
+
+/// Parse a non-negative count token.
+pub(crate) fn count(
+    tok: &str,
+    line: usize,
+    path: &str,
+    format: &'static str,
+) -> Result<u64, IoError> {
+    tok.parse::<u64>().map_err(|_| IoError::Parse {
+        path: path.to_string(),
+        format,
+        line,
+        message: format!("expected a count, found `{}`", short(tok)),
+    })
+}
+
+/// A token shortened for a message.
+pub(crate) fn short(tok: &str) -> String {
+    if tok.chars().count() > 24 {
+        format!("{}…", tok.chars().take(24).collect::<String>())
+    } else {
+        tok.to_string()
+    }
+}
