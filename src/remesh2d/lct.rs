@@ -791,13 +791,36 @@ impl<'a> Work<'a> {
             .filter(|&v| self.valive[v as usize] && !self.fixed[v as usize])
             .collect();
         order.shuffle(rng);
+        // Vertex → triangles, once per pass (smoothing does not change the connectivity). A free
+        // vertex is interior, so its star is closed; order does not matter below.
+        let n = self.pts.len();
+        let mut start = vec![0u32; n + 1];
+        for (i, t) in self.tris.iter().enumerate() {
+            if self.alive[i] {
+                for &x in t {
+                    start[x as usize + 1] += 1;
+                }
+            }
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut incident = vec![0u32; start[n] as usize];
+        for (i, t) in self.tris.iter().enumerate() {
+            if self.alive[i] {
+                for &x in t {
+                    incident[fill[x as usize] as usize] = i as u32;
+                    fill[x as usize] += 1;
+                }
+            }
+        }
         for v in order {
-            let Some(star) = self.star(v) else { continue };
-            // Closed star only (free vertices are interior).
-            let ring: Vec<[u32; 3]> = star.iter().map(|&t| self.rotated(t, v)).collect();
-            if ring.windows(2).any(|w| w[0][2] != w[1][1]) {
+            let star = &incident[start[v as usize] as usize..start[v as usize + 1] as usize];
+            if star.len() < 3 {
                 continue;
             }
+            let ring: Vec<[u32; 3]> = star.iter().map(|&t| self.rotated(t, v)).collect();
             let tens: Vec<(Point2<f64>, Point2<f64>, Matrix2<f64>)> = ring
                 .iter()
                 .map(|t| {
