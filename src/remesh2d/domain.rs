@@ -5,6 +5,7 @@ use super::{Metric2d, PlanarDomain, Remesh2dError};
 use crate::invariants::point_in_polygon;
 use nalgebra::Point2;
 use spade::{ConstrainedDelaunayTriangulation, Triangulation};
+use std::collections::HashMap;
 
 /// Metric length of the segment `[a, b]`, integrated with `n` midpoint samples.
 pub fn metric_length(metric: &dyn Metric2d, a: &Point2<f64>, b: &Point2<f64>, n: usize) -> f64 {
@@ -101,23 +102,67 @@ pub fn triangulate_polygon(
             "polygon self-intersects or has duplicate points".into(),
         ));
     }
-    let mut triangles = Vec::new();
-    for f in cdt.inner_faces() {
-        let vs = f.vertices().map(|v| v.fix().index() as u32);
-        let c = vs
-            .iter()
-            .map(|&i| points[i as usize].coords)
-            .sum::<nalgebra::Vector2<f64>>()
-            / 3.0;
-        // Keep the faces inside the polygon (the CDT covers the convex hull).
-        if point_in_polygon(boundary, &Point2::from(c)) == Some(true) {
-            triangles.push(vs);
+    let all: Vec<[u32; 3]> = cdt
+        .inner_faces()
+        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+        .collect();
+    // Keep the faces inside the polygon (the CDT covers the convex hull), exactly: a face with
+    // a polygon side traversed i → i+1 is inside (faces are CCW, the polygon is CCW), one with
+    // a side traversed i+1 → i is outside, and the status floods across non-polygon edges.
+    let nbu = nb as u32;
+    let is_side = |a: u32, b: u32| a < nbu && b < nbu && ((a + 1) % nbu == b || (b + 1) % nbu == a);
+    let mut he: HashMap<(u32, u32), usize> = HashMap::new();
+    for (f, t) in all.iter().enumerate() {
+        for k in 0..3 {
+            he.insert((t[k], t[(k + 1) % 3]), f);
         }
     }
-    Ok(PlanarDomain {
+    let mut inside: Vec<Option<bool>> = vec![None; all.len()];
+    let mut stack = Vec::new();
+    for (f, t) in all.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if is_side(a, b) {
+                inside[f] = Some(a < nbu && (a + 1) % nbu == b);
+                stack.push(f);
+                break;
+            }
+        }
+    }
+    while let Some(f) = stack.pop() {
+        let t = all[f];
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if is_side(a, b) {
+                continue;
+            }
+            if let Some(&g) = he.get(&(b, a)) {
+                if inside[g].is_none() {
+                    inside[g] = inside[f];
+                    stack.push(g);
+                }
+            }
+        }
+    }
+    let triangles: Vec<[u32; 3]> = all
+        .iter()
+        .zip(&inside)
+        .filter(|(_, s)| **s == Some(true))
+        .map(|(t, _)| *t)
+        .collect();
+    let dom = PlanarDomain {
         points,
         triangles,
         boundary: (0..nb as u32).collect(),
         constrained_edges: Vec::new(),
-    })
+    };
+    // Collinear-looking sides can make spade split a side at a point: check the result.
+    let identity = super::PlanarMesh {
+        points: dom.points.clone(),
+        triangles: dom.triangles.clone(),
+        origin: (0..dom.points.len() as u32).map(Some).collect(),
+    };
+    crate::invariants::certify_planar(&dom, &identity)
+        .map_err(|e| Remesh2dError::InvalidDomain(format!("triangulation: {e}")))?;
+    Ok(dom)
 }

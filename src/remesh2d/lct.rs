@@ -41,8 +41,18 @@ pub struct LctOptions {
     pub max_passes: usize,
     /// Newton steps per vertex and smoothing pass (default 2).
     pub newton_steps: usize,
-    /// Extra smoothing + flip passes after the last round (default 4).
+    /// Final polish passes after the last round: equilateral-apex smoothing + flips (default 6).
     pub final_smoothing: usize,
+    /// `M_T` is the metric sampled at the triangle's centroid (and edge lengths use the metric at
+    /// the edge midpoint) instead of the mean of the vertex tensors (default false: as good on the demo cases, cheaper).
+    pub tensor_at_centroid: bool,
+    /// In the final passes, flip by the max-min metric quality criterion instead of the
+    /// energy (default true).
+    pub final_maxmin_flips: bool,
+    /// After split/collapse, flip towards regular valences instead of by energy (default true).
+    pub valence_flips: bool,
+    /// A valence flip may lower the pair's smaller quality to at most this factor (default 0.5).
+    pub valence_quality_guard: f64,
     /// Run [`certify_planar`] after every round, not only at the end (default true).
     pub certify_every_round: bool,
 }
@@ -56,7 +66,11 @@ impl Default for LctOptions {
             smoothing_iters: 3,
             max_passes: 6,
             newton_steps: 2,
-            final_smoothing: 4,
+            final_smoothing: 6,
+            valence_flips: true,
+            valence_quality_guard: 0.5,
+            final_maxmin_flips: true,
+            tensor_at_centroid: false,
             certify_every_round: true,
         }
     }
@@ -142,15 +156,19 @@ pub fn remesh_planar(
                     break;
                 }
             }
-            w.flip_all();
+            if options.valence_flips {
+                w.valence_flips(options.valence_quality_guard);
+            } else {
+                w.flip_all();
+            }
             for _ in 0..options.smoothing_iters {
-                w.smooth_pass(options, rng)?;
+                w.smooth_pass(options, false, rng)?;
                 w.flip_all();
             }
         } else {
             for _ in 0..options.final_smoothing {
-                w.smooth_pass(options, rng)?;
-                w.flip_all();
+                w.smooth_pass(options, true, rng)?;
+                w.flip_with(options.final_maxmin_flips);
             }
         }
         mesh = w.finish();
@@ -216,6 +234,7 @@ struct Work<'a> {
     l: f64,
     split: f64,
     collapse: f64,
+    at_centroid: bool,
 }
 
 impl<'a> Work<'a> {
@@ -264,6 +283,7 @@ impl<'a> Work<'a> {
             l,
             split: options.split_ratio,
             collapse: options.collapse_ratio,
+            at_centroid: options.tensor_at_centroid,
         };
         w.he.reserve(mesh.triangles.len() * 6);
         for t in &mesh.triangles {
@@ -374,8 +394,14 @@ impl<'a> Work<'a> {
     }
 
     fn edge_len(&self, a: u32, b: u32) -> f64 {
-        let e = self.pts[b as usize] - self.pts[a as usize];
-        let m = (self.vm[a as usize] + self.vm[b as usize]) * 0.5;
+        let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
+        let e = pb - pa;
+        let m = if self.at_centroid {
+            self.sample(&Point2::from((pa.coords + pb.coords) * 0.5))
+        } else {
+            None
+        }
+        .unwrap_or_else(|| (self.vm[a as usize] + self.vm[b as usize]) * 0.5);
         e.dot(&(m * e)).max(0.0).sqrt()
     }
 
@@ -391,9 +417,45 @@ impl<'a> Work<'a> {
         ) == Sign::Positive
     }
 
+    /// The tensor `M_T` of a triangle: the metric at its centroid (`at_centroid`), else the
+    /// mean of its vertex tensors.
+    fn tri_metric(&self, t: [u32; 3]) -> Matrix2<f64> {
+        let p = t.map(|i| self.pts[i as usize]);
+        if self.at_centroid {
+            if let Some(m) = self.sample(&Point2::from(
+                (p[0].coords + p[1].coords + p[2].coords) / 3.0,
+            )) {
+                return m;
+            }
+        }
+        (self.vm[t[0] as usize] + self.vm[t[1] as usize] + self.vm[t[2] as usize]) / 3.0
+    }
+
+    fn sample(&self, p: &Point2<f64>) -> Option<Matrix2<f64>> {
+        clamp_spd(&self.metric.metric(p))
+    }
+
+    /// The metric quality `q = 2√3·a/(p·h)` of triangle `t` in its tensor `M_T`.
+    fn quality(&self, t: [u32; 3]) -> f64 {
+        let p = t.map(|i| self.pts[i as usize]);
+        let m = self.tri_metric(t);
+        let len = |u: usize, v: usize| {
+            let e = p[v] - p[u];
+            e.dot(&(m * e)).max(0.0).sqrt()
+        };
+        let l = [len(1, 2), len(2, 0), len(0, 1)];
+        let area = 0.5 * (p[1] - p[0]).perp(&(p[2] - p[0])) * m.determinant().max(0.0).sqrt();
+        let semi = 0.5 * (l[0] + l[1] + l[2]);
+        let h = l[0].max(l[1]).max(l[2]);
+        if semi > 0.0 && h > 0.0 {
+            2.0 * 3f64.sqrt() * area / (semi * h)
+        } else {
+            0.0
+        }
+    }
+
     fn energy(&self, t: [u32; 3]) -> f64 {
-        let m = (self.vm[t[0] as usize] + self.vm[t[1] as usize] + self.vm[t[2] as usize]) / 3.0;
-        tri_energy(t.map(|i| self.pts[i as usize]), &m)
+        tri_energy(t.map(|i| self.pts[i as usize]), &self.tri_metric(t))
     }
 
     /// Interior, unlocked edges `(a, b)` with `a < b` and their metric lengths, filtered by
@@ -564,6 +626,12 @@ impl<'a> Work<'a> {
     /// `orient2d`) when the LCT energy strictly decreases, until no flip applies. Each flip
     /// lowers the total energy, so this ends; a cap of 20 flips per triangle guards anyway.
     fn flip_all(&mut self) -> usize {
+        self.flip_with(false)
+    }
+
+    /// Flips as in [`Work::flip_all`]; with `maxmin`, the criterion is instead that the smaller
+    /// metric quality `q` of the two triangles strictly increases (the final polish).
+    fn flip_with(&mut self, maxmin: bool) -> usize {
         let mut queue: Vec<(u32, u32)> = Vec::new();
         for (i, t) in self.tris.iter().enumerate() {
             if self.alive[i] {
@@ -596,9 +664,16 @@ impl<'a> Work<'a> {
             if !self.positive(n1) || !self.positive(n2) {
                 continue;
             }
-            let old = self.energy([a, b, c]) + self.energy([b, a, d]);
-            let new = self.energy(n1) + self.energy(n2);
-            if !(new < old * (1.0 - 1e-10)) {
+            let better = if maxmin {
+                let old = self.quality([a, b, c]).min(self.quality([b, a, d]));
+                let new = self.quality(n1).min(self.quality(n2));
+                new > old + 1e-9
+            } else {
+                let old = self.energy([a, b, c]) + self.energy([b, a, d]);
+                let new = self.energy(n1) + self.energy(n2);
+                new < old * (1.0 - 1e-10)
+            };
+            if !better {
                 continue;
             }
             self.set_tri(t1, n1);
@@ -611,6 +686,96 @@ impl<'a> Work<'a> {
         n
     }
 
+    /// Valence-regularising flips (Botsch–Kobbelt style): flip an interior unlocked edge of a
+    /// strictly convex quad when it lowers `Σ (valence − target)²` over the quad's four corners
+    /// (target 6 inside; on the boundary `round(θ/60°) + 1`, θ the corner angle in the vertex's
+    /// tensor) and does not lower the smaller metric quality of the pair below
+    /// `valence_quality_guard` times its old value.
+    fn valence_flips(&mut self, guard: f64) -> usize {
+        let n = self.pts.len();
+        let mut val = vec![0i32; n];
+        let mut target = vec![6i32; n];
+        for (&k, _) in self.he.iter() {
+            let (a, b) = ((k >> 32) as u32, k as u32);
+            if !self.he.contains_key(&key(b, a)) || a < b {
+                val[a as usize] += 1;
+                val[b as usize] += 1;
+            }
+        }
+        for v in 0..n as u32 {
+            if !self.valive[v as usize] || !self.fixed[v as usize] {
+                continue;
+            }
+            let Some(star) = self.star(v) else { continue };
+            let first = self.rotated(star[0], v)[1];
+            let last = self.rotated(star[star.len() - 1], v)[2];
+            let closed =
+                self.he.contains_key(&key(v, last)) && self.he.contains_key(&key(first, v));
+            if closed && self.he.contains_key(&key(last, v)) {
+                continue; // an interior constrained vertex: target 6
+            }
+            let m = self.vm[v as usize];
+            let pv = self.pts[v as usize];
+            let (e1, e2) = (self.pts[first as usize] - pv, self.pts[last as usize] - pv);
+            let (l1, l2) = (e1.dot(&(m * e1)).sqrt(), e2.dot(&(m * e2)).sqrt());
+            let c = (e1.dot(&(m * e2)) / (l1 * l2)).clamp(-1.0, 1.0);
+            // The corner angle is the CCW sweep from `first` to `last` (it may exceed 180°).
+            let mut th = c.acos();
+            if e1.perp(&e2) < 0.0 {
+                th = 2.0 * std::f64::consts::PI - th;
+            }
+            target[v as usize] = ((th / (std::f64::consts::PI / 3.0)).round() as i32).max(1) + 1;
+        }
+        let mut count = 0;
+        let edges: Vec<(u32, u32)> = self
+            .he
+            .keys()
+            .map(|&k| ((k >> 32) as u32, k as u32))
+            .filter(|(a, b)| a < b)
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        for (a, b) in edges {
+            if self.is_locked(a, b) {
+                continue;
+            }
+            let (Some(&t1), Some(&t2)) = (self.he.get(&key(a, b)), self.he.get(&key(b, a))) else {
+                continue;
+            };
+            let c = self.rotated(t1, a)[2];
+            let d = self.rotated(t2, b)[2];
+            if c == d || self.he.contains_key(&key(c, d)) || self.he.contains_key(&key(d, c)) {
+                continue;
+            }
+            let dev = |x: u32, dv: i32| {
+                let e = val[x as usize] + dv - target[x as usize];
+                e * e
+            };
+            let before = dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0);
+            let after = dev(a, -1) + dev(b, -1) + dev(c, 1) + dev(d, 1);
+            if after >= before {
+                continue;
+            }
+            let (n1, n2) = ([a, d, c], [d, b, c]);
+            if !self.positive(n1) || !self.positive(n2) {
+                continue;
+            }
+            let old = self.quality([a, b, c]).min(self.quality([b, a, d]));
+            let new = self.quality(n1).min(self.quality(n2));
+            if new < guard * old {
+                continue;
+            }
+            self.set_tri(t1, n1);
+            self.set_tri(t2, n2);
+            val[a as usize] -= 1;
+            val[b as usize] -= 1;
+            val[c as usize] += 1;
+            val[d as usize] += 1;
+            count += 1;
+        }
+        count
+    }
+
     /// Vertex position optimisation: every free vertex, in a seeded random order, moves to
     /// the minimiser of its 1-ring energy `Σ_T E_T(x)` (tensors frozen at the current
     /// positions): Newton steps on the cubic `E_T = A_T(x)·S_T(x)/8`, with the positive
@@ -619,27 +784,50 @@ impl<'a> Work<'a> {
     fn smooth_pass(
         &mut self,
         options: &LctOptions,
+        apex: bool,
         rng: &mut ChaCha8Rng,
     ) -> Result<(), Remesh2dError> {
         let mut order: Vec<u32> = (0..self.pts.len() as u32)
             .filter(|&v| self.valive[v as usize] && !self.fixed[v as usize])
             .collect();
         order.shuffle(rng);
+        // Vertex → triangles, once per pass (smoothing does not change the connectivity). A free
+        // vertex is interior, so its star is closed; order does not matter below.
+        let n = self.pts.len();
+        let mut start = vec![0u32; n + 1];
+        for (i, t) in self.tris.iter().enumerate() {
+            if self.alive[i] {
+                for &x in t {
+                    start[x as usize + 1] += 1;
+                }
+            }
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut incident = vec![0u32; start[n] as usize];
+        for (i, t) in self.tris.iter().enumerate() {
+            if self.alive[i] {
+                for &x in t {
+                    incident[fill[x as usize] as usize] = i as u32;
+                    fill[x as usize] += 1;
+                }
+            }
+        }
         for v in order {
-            let Some(star) = self.star(v) else { continue };
-            // Closed star only (free vertices are interior).
-            let ring: Vec<[u32; 3]> = star.iter().map(|&t| self.rotated(t, v)).collect();
-            if ring.windows(2).any(|w| w[0][2] != w[1][1]) {
+            let star = &incident[start[v as usize] as usize..start[v as usize + 1] as usize];
+            if star.len() < 3 {
                 continue;
             }
-            let mv = self.vm[v as usize];
+            let ring: Vec<[u32; 3]> = star.iter().map(|&t| self.rotated(t, v)).collect();
             let tens: Vec<(Point2<f64>, Point2<f64>, Matrix2<f64>)> = ring
                 .iter()
                 .map(|t| {
                     (
                         self.pts[t[1] as usize],
                         self.pts[t[2] as usize],
-                        (mv + self.vm[t[1] as usize] + self.vm[t[2] as usize]) / 3.0,
+                        self.tri_metric(*t),
                     )
                 })
                 .collect();
@@ -650,8 +838,25 @@ impl<'a> Work<'a> {
             };
             let x0 = self.pts[v as usize];
             let mut x = x0;
+            if apex {
+                if let Some(xn) = apex_target(&tens) {
+                    let step = xn - x0;
+                    let mut t = 1.0;
+                    for _ in 0..12 {
+                        let xn = x0 + step * t;
+                        if tens
+                            .iter()
+                            .all(|(p, q, _)| orient2d(&xn, p, q) == Sign::Positive)
+                        {
+                            x = xn;
+                            break;
+                        }
+                        t *= 0.5;
+                    }
+                }
+            }
             let mut e = energy(&x);
-            for _ in 0..options.newton_steps {
+            for _ in 0..if apex { 0 } else { options.newton_steps } {
                 let mut g = Vector2::zeros();
                 let mut h = Matrix2::zeros();
                 let mut h0 = Matrix2::zeros();
@@ -730,6 +935,24 @@ impl<'a> Work<'a> {
             origin,
         }
     }
+}
+
+/// The mean over the 1-ring triangles `(x, p, q)` of the apex that makes each one equilateral
+/// in its tensor: with `M = L Lᵀ` and `y = Lᵀ x`, the apex is
+/// `y = (y_p + y_q)/2 + √3/2 · rot90(y_q − y_p)` mapped back.
+fn apex_target(tens: &[(Point2<f64>, Point2<f64>, Matrix2<f64>)]) -> Option<Point2<f64>> {
+    let mut acc = Vector2::zeros();
+    for (p, q, m) in tens {
+        let l = m.cholesky()?.l();
+        let lt = l.transpose();
+        let lti = lt.try_inverse()?;
+        let (yp, yq) = (lt * p.coords, lt * q.coords);
+        let d = yq - yp;
+        let y = (yp + yq) * 0.5 + Vector2::new(-d.y, d.x) * (3f64.sqrt() / 2.0);
+        acc += lti * y;
+    }
+    let c = acc / tens.len() as f64;
+    c.iter().all(|x| x.is_finite()).then(|| Point2::from(c))
 }
 
 /// Evaluate the metric, clamped to SPD ([`clamp_spd`]).
