@@ -67,7 +67,9 @@ pub enum PipelineError {
     #[error("final mesh: {0}")]
     Final(InvariantError),
     /// The strategy returned a patch without an unprocessed face (the loop would not end).
-    #[error("patch {patch} (seed {seed}) contains no unprocessed face; the strategy must make progress")]
+    #[error(
+        "patch {patch} (seed {seed}) contains no unprocessed face; the strategy must make progress"
+    )]
     NoProgress {
         /// which patch
         patch: PatchId,

@@ -398,6 +398,12 @@ fn check_attributes(mesh: &TriMesh, attrs: &MeshAttributes, path: &str) -> Resul
     Ok(())
 }
 
+/// Write `bytes` to `path` atomically (temporary file beside it, then rename), e.g. a JSON
+/// report: a failure leaves no partial file.
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
+    write_atomic(path, |w| w.write_all(bytes))
+}
+
 /// Write through `body` into a temporary file beside `path`, then rename it to `path`.
 /// On any error the temporary file is removed (dropped) and `path` is left untouched.
 fn write_atomic(
