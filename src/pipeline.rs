@@ -23,7 +23,7 @@ use crate::lift::{lift, PatchFrame};
 use crate::mesh::{SurfaceLocation, Topology, TriMesh};
 use crate::metric::MetricField;
 use crate::param::{DistortionReport, Parameterizer, SymmetricDirichlet};
-use crate::patches::{extract_patch, ConePatches, PatchContext, PatchStrategy};
+use crate::patches::{extract_patch, ConePatches, DiskPatch, PatchContext, PatchStrategy};
 use crate::remesh2d::{
     transfer_metric, Lct, PlanarDomain, PlanarMetricField, PlanarRemesher, TransferMethod,
 };
@@ -52,14 +52,14 @@ pub enum PipelineError {
         message: String,
     },
     /// A certificate on the working mesh failed after a patch was stitched.
-    #[error("after patch {patch} (seed {seed}): {source}{}", debug_note(.debug_file))]
+    #[error("after patch {patch} (seed {seed}): {violation}{}", debug_note(.debug_file))]
     Certificate {
         /// which patch (`p0` before the first one)
         patch: PatchId,
         /// its seed vertex
         seed: VertexId,
         /// the violated invariant, naming the elements
-        source: InvariantError,
+        violation: InvariantError,
         /// where the offending patch was written
         debug_file: Option<PathBuf>,
     },
@@ -109,6 +109,9 @@ pub struct RemeshOptions {
     pub debug_dir: Option<PathBuf>,
     /// Stop after this many patches (error), to bound runaway runs.
     pub max_patches: Option<usize>,
+    /// Stop at the first failed patch attempt instead of shrinking the patch and retrying
+    /// (for invariant-checking runs that want every failure to be an error).
+    pub strict: bool,
 }
 
 impl Default for RemeshOptions {
@@ -120,6 +123,7 @@ impl Default for RemeshOptions {
             check_self_intersections: true,
             debug_dir: None,
             max_patches: None,
+            strict: false,
         }
     }
 }
@@ -210,6 +214,10 @@ pub struct PatchRecord {
     pub cone_angle_deg: Option<f64>,
     /// Distortion of its parameterization.
     pub distortion: DistortionReport,
+    /// Failed attempts before this one (each shrank the patch).
+    pub retries: usize,
+    /// Even the smallest attempt failed: the faces were kept unchanged.
+    pub kept: bool,
 }
 
 /// The outcome of Algorithm 1.
@@ -240,6 +248,8 @@ pub struct RemeshReport {
     pub times: StageTimes,
     /// Certificates.
     pub certificate: Certificate,
+    /// What the retry ladder did.
+    pub fallbacks: Fallbacks,
     /// Per-patch records.
     pub patch_records: Vec<PatchRecord>,
     /// Input and output sizes.
@@ -316,6 +326,7 @@ pub fn remesh(
     let mut topo = ref_topo.clone();
 
     let mut n_patch = 0usize;
+    let mut fallback = Fallbacks::default();
     loop {
         if work.unprocessed() == 0 {
             break;
@@ -326,7 +337,7 @@ pub fn remesh(
             }
         }
         let pid = PatchId::new(n_patch);
-        // (a) next patch, certified a disk.
+        // (a) next patch from the strategy.
         let t0 = Instant::now();
         let ctx = PatchContext {
             mesh: &work.mesh,
@@ -346,138 +357,106 @@ pub fn remesh(
                 })
             }
         };
-        let seed = patch.seed_vertex;
-        let stage_err = |stage: &'static str, message: String| PipelineError::Stage {
-            patch: pid,
-            seed,
-            stage,
-            message,
-        };
-        let unprocessed_in = patch
-            .faces
-            .iter()
-            .filter(|f| !work.processed[f.idx()])
-            .count();
-        if unprocessed_in == 0 {
-            return Err(PipelineError::NoProgress { patch: pid, seed });
-        }
-        invariants::certify_disk(&work.mesh, &patch.faces).map_err(|e| {
-            PipelineError::Certificate {
-                patch: pid,
-                seed,
-                source: e,
-                debug_file: write_debug(options, pid, "patch", &work.mesh, &patch.faces),
-            }
-        })?;
-        cert.disk += 1;
-        let disk = extract_patch(&work.mesh, &patch.faces)
-            .map_err(|e| stage_err("patch extraction", e.to_string()))?;
         times.patches += t0.elapsed().as_secs_f64();
-
-        // (b) bijective parameterization, certified (the parameterizer certifies; we check
-        // again because it is a research extension point).
-        let t0 = Instant::now();
-        let param = stages
-            .parameterizer
-            .parameterize(&disk.mesh, &disk.boundary)
-            .map_err(|e| stage_err("parameterization", e.to_string()))?;
-        invariants::certify_bijective(&param.uv, &disk.mesh.triangles, &disk.boundary).map_err(
-            |e| PipelineError::Certificate {
-                patch: pid,
-                seed,
-                source: e,
-                debug_file: write_debug(options, pid, "param", &work.mesh, &patch.faces),
-            },
-        )?;
-        cert.bijective += 1;
-        if param.report.fell_back {
-            cert.param_fallbacks += 1;
-        }
-        times.param += t0.elapsed().as_secs_f64();
-
-        // (c) metric transfer (Eq. 4): 3D metric read from the reference field at each patch
-        // vertex's reference location, carried to the plane.
-        let t0 = Instant::now();
-        let metrics3d: Vec<Matrix3<f64>> = disk
-            .to_global
-            .iter()
-            .map(|g| field.eval_at(&work.locations[g.idx()]))
-            .collect();
-        let metrics2d = transfer_metric(&disk.mesh, &param.uv, &metrics3d, options.transfer)
-            .map_err(|e| stage_err("metric transfer", e.to_string()))?;
-        let tris_u32: Vec<[u32; 3]> = disk
-            .mesh
-            .triangles
-            .iter()
-            .map(|t| [t[0].0, t[1].0, t[2].0])
-            .collect();
-        let planar_field = PlanarMetricField::new(param.uv.clone(), tris_u32.clone(), metrics2d)
-            .map_err(|e| stage_err("metric transfer", e.to_string()))?;
-        times.transfer += t0.elapsed().as_secs_f64();
-
-        // (d) planar remeshing with the patch boundary fixed, certified.
-        let t0 = Instant::now();
-        let domain = PlanarDomain {
-            points: param.uv.clone(),
-            triangles: tris_u32,
-            boundary: disk.boundary.iter().map(|v| v.0).collect(),
-            constrained_edges: Vec::new(),
-        };
-        let planar = stages
-            .remesher
-            .remesh(&domain, &planar_field, l_tar, &mut rng)
-            .map_err(|e| stage_err("planar remeshing", e.to_string()))?;
-        invariants::certify_planar(&domain, &planar).map_err(|e| PipelineError::Certificate {
-            patch: pid,
-            seed,
-            source: e,
-            debug_file: write_debug(options, pid, "remesh2d", &work.mesh, &patch.faces),
-        })?;
-        cert.planar += 1;
-        times.remesh2d += t0.elapsed().as_secs_f64();
-
-        // (e) map back: barycentric location in the initial 2D mesh, then onto the reference.
-        let t0 = Instant::now();
-        let frame = PatchFrame {
-            triangles: &disk.mesh.triangles,
-            positions: &disk.mesh.positions,
-            to_global: &disk.to_global,
-        };
-        let replacement = lift(
-            &planar,
-            &frame,
-            |p| planar_field.locate(p),
-            |p| field.project(p).0,
-            reference,
-        )
-        .map_err(|e| stage_err("mapping back", e.to_string()))?;
-        times.lift += t0.elapsed().as_secs_f64();
-
-        // (f) certify the candidate's new faces before touching the working mesh.
-        let t0 = Instant::now();
-        certify_replacement(field, &work, &replacement).map_err(|e| {
-            PipelineError::Certificate {
-                patch: pid,
-                seed,
-                source: e,
-                debug_file: write_debug(options, pid, "lift", &work.mesh, &patch.faces),
+        let seed = patch.seed_vertex;
+        let mut faces = patch.faces.clone();
+        let failures_before = fallback.failures.len();
+        // Retry ladder: a patch whose stages fail (no certified map, remesher error, a lifted
+        // face flipped or degenerate) is shrunk to a smaller disk around an unprocessed face
+        // and tried again; a patch of MIN_PATCH_FACES that still fails keeps its faces as they
+        // are (marked processed). Either way every face that enters the working mesh is
+        // certified, and the unprocessed count strictly decreases (termination).
+        let (new_faces, outcome) = loop {
+            let unprocessed_in = faces.iter().filter(|f| !work.processed[f.idx()]).count();
+            if unprocessed_in == 0 {
+                return Err(PipelineError::NoProgress { patch: pid, seed });
             }
-        })?;
-        cert.no_degenerate += 1;
-        cert.no_flips += 1;
-        times.certify += t0.elapsed().as_secs_f64();
+            // The disk certificate is a hard error: a strategy (or the shrinking) that
+            // returns a non-disk is a bug, not a numerical accident.
+            let t0 = Instant::now();
+            invariants::certify_disk(&work.mesh, &faces).map_err(|e| {
+                PipelineError::Certificate {
+                    patch: pid,
+                    seed,
+                    violation: e,
+                    debug_file: write_debug(options, pid, "patch", &work.mesh, &faces),
+                }
+            })?;
+            cert.disk += 1;
+            times.patches += t0.elapsed().as_secs_f64();
+            let attempt = remesh_patch(
+                field, stages, options, &work, &faces, l_tar, &mut rng, &mut times, &mut cert,
+            );
+            match attempt {
+                Ok((replacement, distortion)) => {
+                    let t0 = Instant::now();
+                    let new_faces = stitch(&mut work, &faces, &replacement).map_err(|e| {
+                        PipelineError::Stage {
+                            patch: pid,
+                            seed,
+                            stage: "stitching",
+                            message: e.to_string(),
+                        }
+                    })?;
+                    times.stitch += t0.elapsed().as_secs_f64();
+                    break (
+                        new_faces,
+                        PatchRecord {
+                            id: pid.0,
+                            seed: seed.0,
+                            faces_in: faces.len(),
+                            unprocessed_in,
+                            faces_out: replacement.triangles.len(),
+                            cone_angle_deg: patch.cone.map(|c| c.angle.to_degrees()),
+                            distortion,
+                            retries: 0,
+                            kept: false,
+                        },
+                    );
+                }
+                Err(failure) => {
+                    fallback
+                        .failures
+                        .push(format!("{pid} ({} faces): {failure}", faces.len()));
+                    if options.strict {
+                        return Err(failure.into_error(pid, seed, options, &work, &faces));
+                    }
+                    if faces.len() <= MIN_PATCH_FACES {
+                        // Keep the faces: mark them processed, unchanged.
+                        for f in &faces {
+                            work.processed[f.idx()] = true;
+                        }
+                        fallback.kept_faces += unprocessed_in;
+                        break (
+                            faces.clone(),
+                            PatchRecord {
+                                id: pid.0,
+                                seed: seed.0,
+                                faces_in: faces.len(),
+                                unprocessed_in,
+                                faces_out: faces.len(),
+                                cone_angle_deg: None,
+                                distortion: DistortionReport::default(),
+                                retries: 0,
+                                kept: true,
+                            },
+                        );
+                    }
+                    fallback.shrinks += 1;
+                    faces = shrink_patch(&work, &topo, &faces, patch.seed_face, faces.len() / 2);
+                }
+            }
+        };
+        let mut record = outcome;
+        record.retries = fallback.failures.len() - failures_before;
 
-        // (g) stitch and certify the working mesh.
-        let t0 = Instant::now();
-        let new_faces = stitch(&mut work, &patch.faces, &replacement)
-            .map_err(|e| stage_err("stitching", e.to_string()))?;
-        times.stitch += t0.elapsed().as_secs_f64();
+        // (g) certify the working mesh after the patch (hard errors: these are bugs).
         let t0 = Instant::now();
         topo = Topology::build(&work.mesh);
         let fail = |e: InvariantError, work: &WorkingMesh| PipelineError::Certificate {
             patch: pid,
             seed,
-            source: e,
+            violation: e,
             debug_file: write_debug(options, pid, "stitched", &work.mesh, &new_faces),
         };
         invariants::certify_manifold(&work.mesh, &topo).map_err(|e| fail(e, &work))?;
@@ -501,15 +480,7 @@ pub fn remesh(
         cert.boundary_preserved += 1;
         times.certify += t0.elapsed().as_secs_f64();
 
-        records.push(PatchRecord {
-            id: pid.0,
-            seed: seed.0,
-            faces_in: patch.faces.len(),
-            unprocessed_in,
-            faces_out: new_faces.len(),
-            cone_angle_deg: patch.cone.map(|c| c.angle.to_degrees()),
-            distortion: param.report.clone(),
-        });
+        records.push(record);
         n_patch += 1;
         on_progress(Progress {
             patches: n_patch,
@@ -537,6 +508,7 @@ pub fn remesh(
         patches: n_patch,
         times,
         certificate: cert,
+        fallbacks: fallback,
         patch_records: records,
         faces_in: reference.n_faces(),
         faces_out: work.mesh.n_faces(),
@@ -547,6 +519,229 @@ pub fn remesh(
         locations: work.locations,
         report,
     })
+}
+
+/// Smallest patch the retry ladder shrinks to before keeping the faces unchanged.
+pub const MIN_PATCH_FACES: usize = 8;
+
+/// What the retry ladder did (see [`remesh`]).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Fallbacks {
+    /// Patches shrunk after a failed attempt.
+    pub shrinks: usize,
+    /// Unprocessed input faces kept unchanged because even a minimal patch failed.
+    pub kept_faces: usize,
+    /// Every failed attempt: patch, size and reason.
+    pub failures: Vec<String>,
+}
+
+/// A recoverable failure of one patch attempt.
+struct Failure {
+    stage: &'static str,
+    message: String,
+    violation: Option<InvariantError>,
+    candidate: Option<Replacement>,
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.stage, self.message)
+    }
+}
+
+impl Failure {
+    fn stage(stage: &'static str, e: impl std::fmt::Display) -> Failure {
+        Failure {
+            stage,
+            message: e.to_string(),
+            violation: None,
+            candidate: None,
+        }
+    }
+    fn certificate(stage: &'static str, e: InvariantError) -> Failure {
+        Failure {
+            stage,
+            message: e.to_string(),
+            violation: Some(e),
+            candidate: None,
+        }
+    }
+    fn into_error(
+        self,
+        pid: PatchId,
+        seed: VertexId,
+        options: &RemeshOptions,
+        work: &WorkingMesh,
+        faces: &[FaceId],
+    ) -> PipelineError {
+        let patch_file = write_debug(options, pid, self.stage, &work.mesh, faces);
+        let cand = self
+            .candidate
+            .as_ref()
+            .and_then(|c| write_candidate(options, pid, work, c));
+        match self.violation {
+            Some(v) => PipelineError::Certificate {
+                patch: pid,
+                seed,
+                violation: v,
+                debug_file: cand.or(patch_file),
+            },
+            None => PipelineError::Stage {
+                patch: pid,
+                seed,
+                stage: self.stage,
+                message: self.message,
+            },
+        }
+    }
+}
+
+/// Stages (b)–(f) of Algorithm 1 for one disk patch of the working mesh: parameterize
+/// (certified bijective), transfer the metric (Eq. 4), remesh in 2D with the boundary fixed
+/// (certified), lift onto the reference surface, and certify the new faces (none degenerate,
+/// none flipped).
+#[allow(clippy::too_many_arguments)]
+fn remesh_patch(
+    field: &MetricField,
+    stages: &Stages,
+    options: &RemeshOptions,
+    work: &WorkingMesh,
+    faces: &[FaceId],
+    l_tar: f64,
+    rng: &mut crate::Rng,
+    times: &mut StageTimes,
+    cert: &mut Certificate,
+) -> Result<(Replacement, DistortionReport), Failure> {
+    let reference = field.reference();
+    let disk =
+        extract_patch(&work.mesh, faces).map_err(|e| Failure::stage("patch extraction", e))?;
+
+    // (b) bijective parameterization, certified (the parameterizer certifies; we check again
+    // because it is a research extension point).
+    let t0 = Instant::now();
+    let param = stages
+        .parameterizer
+        .parameterize(&disk.mesh, &disk.boundary)
+        .map_err(|e| Failure::stage("parameterization", e))?;
+    invariants::certify_bijective(&param.uv, &disk.mesh.triangles, &disk.boundary)
+        .map_err(|e| Failure::certificate("parameterization", e))?;
+    cert.bijective += 1;
+    if param.report.fell_back {
+        cert.param_fallbacks += 1;
+    }
+    times.param += t0.elapsed().as_secs_f64();
+
+    // (c) metric transfer (Eq. 4): the 3D metric is read from the reference field at each
+    // patch vertex's reference location and carried to the plane.
+    let t0 = Instant::now();
+    let metrics3d: Vec<Matrix3<f64>> = disk
+        .to_global
+        .iter()
+        .map(|g| field.eval_at(&work.locations[g.idx()]))
+        .collect();
+    let metrics2d = transfer_metric(&disk.mesh, &param.uv, &metrics3d, options.transfer)
+        .map_err(|e| Failure::stage("metric transfer", e))?;
+    let tris_u32: Vec<[u32; 3]> = disk
+        .mesh
+        .triangles
+        .iter()
+        .map(|t| [t[0].0, t[1].0, t[2].0])
+        .collect();
+    let planar_field = PlanarMetricField::new(param.uv.clone(), tris_u32.clone(), metrics2d)
+        .map_err(|e| Failure::stage("metric transfer", e))?;
+    times.transfer += t0.elapsed().as_secs_f64();
+
+    // (d) planar remeshing with the patch boundary fixed, certified.
+    let t0 = Instant::now();
+    let domain = PlanarDomain {
+        points: param.uv.clone(),
+        triangles: tris_u32,
+        boundary: disk.boundary.iter().map(|v| v.0).collect(),
+        constrained_edges: Vec::new(),
+    };
+    let planar = stages
+        .remesher
+        .remesh(&domain, &planar_field, l_tar, rng)
+        .map_err(|e| Failure::stage("planar remeshing", e))?;
+    invariants::certify_planar(&domain, &planar)
+        .map_err(|e| Failure::certificate("planar remeshing", e))?;
+    cert.planar += 1;
+    times.remesh2d += t0.elapsed().as_secs_f64();
+
+    // (e) map back: barycentric location in the initial 2D mesh, then onto the reference.
+    let t0 = Instant::now();
+    let frame = PatchFrame {
+        triangles: &disk.mesh.triangles,
+        positions: &disk.mesh.positions,
+        to_global: &disk.to_global,
+    };
+    let replacement = lift(
+        &planar,
+        &frame,
+        |p| planar_field.locate(p),
+        |p| field.project(p).0,
+        reference,
+    )
+    .map_err(|e| Failure::stage("mapping back", e))?;
+    times.lift += t0.elapsed().as_secs_f64();
+
+    // (f) certify the candidate's new faces before touching the working mesh.
+    let t0 = Instant::now();
+    let checked = certify_replacement(field, work, &replacement);
+    times.certify += t0.elapsed().as_secs_f64();
+    if let Err(e) = checked {
+        let mut f = Failure::certificate("lifted faces", e);
+        f.candidate = Some(replacement);
+        return Err(f);
+    }
+    cert.no_degenerate += 1;
+    cert.no_flips += 1;
+    Ok((replacement, param.report))
+}
+
+/// A smaller disk inside `faces`: grown face by face (breadth first, exact disk rule) from
+/// `seed_face` if it is unprocessed, else from the first unprocessed face, up to `target`
+/// faces. Deterministic.
+fn shrink_patch(
+    work: &WorkingMesh,
+    topo: &Topology,
+    faces: &[FaceId],
+    seed_face: FaceId,
+    target: usize,
+) -> Vec<FaceId> {
+    let inside: HashSet<FaceId> = faces.iter().copied().collect();
+    let start = if inside.contains(&seed_face) && !work.processed[seed_face.idx()] {
+        seed_face
+    } else {
+        match faces.iter().find(|f| !work.processed[f.idx()]) {
+            Some(f) => *f,
+            None => return faces.to_vec(),
+        }
+    };
+    let ctx = PatchContext {
+        mesh: &work.mesh,
+        topology: topo,
+        processed: &work.processed,
+        feature_edges: None,
+    };
+    let mut disk = DiskPatch::new(&ctx, start);
+    let mut queue = std::collections::VecDeque::from([start]);
+    while let Some(f) = queue.pop_front() {
+        if disk.len() >= target.max(1) {
+            break;
+        }
+        for i in 0..3 {
+            if let Some(g) = topo.neighbor(f, i) {
+                if inside.contains(&g) && !disk.contains(g) && disk.try_add(g).is_ok() {
+                    queue.push_back(g);
+                    if disk.len() >= target.max(1) {
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    disk.sorted_faces()
 }
 
 /// The new faces of a candidate replacement: none degenerate (exact), none flipped against
@@ -640,6 +835,39 @@ fn certify_input_boundary(
         return Err(InvariantError::BoundaryEdgesMissing(Offenders(missing)));
     }
     Ok(())
+}
+
+/// Write a candidate replacement (the lifted remesh of a patch) as OBJ into the debug
+/// directory, next to the patch it would replace.
+fn write_candidate(
+    options: &RemeshOptions,
+    patch: PatchId,
+    work: &WorkingMesh,
+    r: &Replacement,
+) -> Option<PathBuf> {
+    use crate::stitch::PatchVertex;
+    let dir = options.debug_dir.as_ref()?;
+    let mut positions = work.mesh.positions.clone();
+    let base = positions.len() as u32;
+    positions.extend_from_slice(&r.new_positions);
+    let triangles = r
+        .triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| match v {
+                PatchVertex::Existing(g) => g,
+                PatchVertex::New(i) => VertexId(base + i),
+            })
+        })
+        .collect();
+    let (sub, _) = TriMesh {
+        positions,
+        triangles,
+    }
+    .without_unreferenced_vertices();
+    let path = dir.join(format!("conemesh-failed-{patch}-candidate.obj"));
+    crate::io::write_mesh(&path, &sub).ok()?;
+    Some(path)
 }
 
 /// Write the offending patch (faces of `mesh`) as OBJ into the debug directory.
