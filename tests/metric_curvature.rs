@@ -257,3 +257,21 @@ fn unreferenced_vertices_do_not_break_curvature_or_field() -> R {
     assert!(last.iter().all(|x| x.is_finite()));
     Ok(())
 }
+
+#[test]
+fn principal_curvatures_are_deterministic() -> R {
+    let m = generators::torus(1.0, 0.4, 40, 20);
+    let bits = |v: &[conemesh::metric::PrincipalCurvature]| -> Vec<u64> {
+        v.iter()
+            .flat_map(|c| {
+                [c.k1, c.k2, c.d1.x, c.d1.y, c.d1.z, c.normal.x]
+                    .map(f64::to_bits)
+                    .to_vec()
+            })
+            .collect()
+    };
+    let a = principal_curvatures(&m, &CurvatureOptions::default())?;
+    let b = principal_curvatures(&m, &CurvatureOptions::default())?;
+    assert_eq!(bits(&a), bits(&b));
+    Ok(())
+}
