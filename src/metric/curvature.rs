@@ -13,8 +13,9 @@
 //!    term, the surface passes through `v`) is fitted to the neighbours' frame coordinates by
 //!    least squares (SVD, coordinates scaled by the neighbourhood size for conditioning);
 //! 4. the principal curvatures are (minus) the eigenvalues of the fitted surface's shape operator
-//!    `I⁻¹ II` at `v`, symmetrised as libigl does, and the principal directions its eigenvectors
-//!    mapped to 3D in the tangent plane of `n₀` (`t₁ x¹ + t₂ x²`), as libigl does.
+//!    `I⁻¹ II` at `v` (libigl uses a symmetrised approximation, see `paper-notes.md`), and `d₁`
+//!    is its eigenvector for `k₁` mapped to 3D and projected on the tangent plane of `n₀`, as libigl
+//!    reports directions; `d₂ = n₀ × d₁`.
 //!
 //! Sign: `k > 0` where the surface bends away from its normal (a sphere with outward normals has
 //! `k₁ = k₂ = +1/r`), as in libigl.
@@ -267,19 +268,28 @@ fn fit_vertex(
     let w = (1.0 + d * d + e * e).sqrt();
     let (ee, ff, gg) = (1.0 + d * d, d * e, 1.0 + e * e);
     let (l, m_, nn) = (2.0 * a / w, b / w, 2.0 * c / w);
-    // Shape operator I⁻¹ II, symmetrised as libigl does (its off-diagonal M E − L F on both
-    // sides; exact when d = e = 0, i.e. when the vertex normal is the fitted normal, and off by
-    // O(d² + e²) otherwise). The symmetric form keeps the principal directions orthogonal in the
-    // tangent plane of the vertex normal n₀, which is where the metric is used (Sec. 4.1 builds
-    // M from (d₁, d₂, d₁ × d₂); Eq. 4 projects onto the plane of d₁, d₂).
-    let off = m_ * ee - l * ff;
-    let shape = Matrix2::new(l * gg - m_ * ff, off, off, nn * ee - m_ * ff) / (ee * gg - ff * ff);
-    let eig = SymmetricEigen::new(shape);
+    // Principal curvatures: eigenvalues of the shape operator I⁻¹ II (the generalised symmetric
+    // problem II x = λ I x, solved through the Cholesky factor I = R Rᵀ: S = R⁻¹ II R⁻ᵀ,
+    // x = R⁻ᵀ y). libigl symmetrises I⁻¹ II instead (its off-diagonal M E − L F on both sides),
+    // which is exact only when d = e = 0 and then depends on the frame's tangent axis; the exact
+    // operator does not, so the result is independent of how (t₁, t₂) is chosen.
+    let r11 = ee.sqrt();
+    let r21 = ff / r11;
+    let r22 = (gg - r21 * r21).sqrt();
+    let Some(r_inv) = Matrix2::new(r11, 0.0, r21, r22).try_inverse() else {
+        return planar(n0);
+    };
+    let second = Matrix2::new(l, m_, m_, nn);
+    let s = r_inv * second * r_inv.transpose();
+    let eig = SymmetricEigen::new((s + s.transpose()) * 0.5);
     // k = −λ: the graph of a sphere seen from its outward normal has f = −(u²+v²)/2r, λ = −1/r.
+    // Directions: the 3D tangent x_u x¹ + x_v x² = (t₁ + d n₀) x¹ + (t₂ + e n₀) x², projected on
+    // the tangent plane of n₀ (as libigl reports them), where the metric lives (Sec. 4.1 builds
+    // M from (d₁, d₂, d₁ × d₂); Eq. 4 projects onto the plane of d₁, d₂).
     let mut pairs: Vec<(f64, Vector3<f64>)> = (0..2)
         .map(|i| {
-            let y = eig.eigenvectors.column(i);
-            (-eig.eigenvalues[i], t1 * y[0] + t2 * y[1])
+            let x = r_inv.transpose() * eig.eigenvectors.column(i);
+            (-eig.eigenvalues[i], t1 * x[0] + t2 * x[1])
         })
         .collect();
     pairs.sort_by(|p, q| {
