@@ -405,4 +405,44 @@ mod tests {
         assert!(apex.normal.z > 0.999, "{apex:?}");
         Ok(())
     }
+
+    fn wedge(angle: f64) -> Result<TriMesh, MetricError> {
+        // A crease z = −0.3x (x > 0), z = 1.2x (x < 0), plus a y² bend: at the crease the vertex
+        // normal is far from the fitted surface's normal (d, e ≠ 0 in the frame).
+        let (c, s) = (angle.cos(), angle.sin());
+        let nx = 21;
+        let mut pos = Vec::new();
+        for j in 0..nx {
+            for i in 0..nx {
+                let x = (i as f64 - 10.0) * 0.01;
+                let y = (j as f64 - 10.0) * 0.01;
+                let z = if x > 0.0 { -0.3 * x } else { 1.2 * x } - y * y;
+                pos.push(nalgebra::Point3::new(c * x - s * y, s * x + c * y, z));
+            }
+        }
+        let mut tris = Vec::new();
+        for j in 0..nx - 1 {
+            for i in 0..nx - 1 {
+                let a = j * nx + i;
+                tris.push([a, a + 1, a + nx + 1]);
+                tris.push([a, a + nx + 1, a + nx]);
+            }
+        }
+        Ok(TriMesh::from_indices(pos, &tris)?)
+    }
+
+    #[test]
+    fn curvatures_do_not_depend_on_the_frame_tangent_axis_at_a_crease() -> Result<(), MetricError> {
+        // Deliberate difference to libigl (paper-notes § 3.1): the exact shape operator is
+        // independent of the tangent axis of the fitting frame; libigl's symmetrised one is not
+        // when the vertex normal differs from the fitted normal. Rotating the mesh about z changes
+        // which axis `tangent_frame` picks relative to the surface.
+        let centre = 10 * 21 + 10;
+        let a = principal_curvatures(&wedge(0.0)?, &CurvatureOptions::default())?[centre];
+        let b = principal_curvatures(&wedge(0.5)?, &CurvatureOptions::default())?[centre];
+        assert!(a.k1.abs() > 1.0, "{a:?}");
+        assert!((a.k1 - b.k1).abs() < 1e-9 * a.k1.abs(), "{a:?} {b:?}");
+        assert!((a.k2 - b.k2).abs() < 1e-9 * a.k1.abs(), "{a:?} {b:?}");
+        Ok(())
+    }
 }
