@@ -275,3 +275,26 @@ fn principal_curvatures_are_deterministic() -> R {
     assert_eq!(bits(&a), bits(&b));
     Ok(())
 }
+
+#[test]
+fn tiny_components_get_zero_curvature_and_a_valid_field() -> R {
+    // One triangle: two neighbours per vertex, too few for the 5-parameter fit.
+    let m = TriMesh::from_indices(
+        vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, 1.0, 0.2),
+        ],
+        &[[0, 1, 2]],
+    )?;
+    let pc = principal_curvatures(&m, &CurvatureOptions::default())?;
+    let n = m.face_normal(FaceId(0));
+    for c in &pc {
+        assert_eq!((c.k1, c.k2), (0.0, 0.0));
+        assert!((c.normal - n).norm() < 1e-12);
+    }
+    let field = MetricField::from_curvature(m, &MetricOptions::default())?;
+    let at = field.eval(&Point3::new(0.2, 0.2, 1.0));
+    assert!((at * n).norm() < 1e-15);
+    Ok(())
+}

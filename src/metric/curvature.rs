@@ -207,7 +207,7 @@ fn fit_vertex(
     // Frame normal: the vertex's own area-weighted normal (libigl's default, `localMode` with
     // `AVERAGE` normals).
     let n0 = normals[v];
-    if !n0.norm().is_finite() || n0.norm() <= 0.0 || ring.len() < 2 {
+    if !n0.norm().is_finite() || n0.norm() <= 0.0 || ring.len() < MIN_NEIGHBOURS {
         return planar(n0);
     }
     let n0 = n0.normalize();
@@ -325,8 +325,9 @@ fn fit_vertex(
 /// `opts.radius` rings, see the module doc). Shapes: one entry per vertex, in vertex order.
 /// Units: curvature in 1/(mesh units); callers pass the unit-space mesh (Sec. 3.1 notes).
 ///
-/// Unreferenced vertices and vertices whose neighbourhood cannot be fitted (fewer than two
-/// neighbours, degenerate geometry) get `k1 = k2 = 0` and a frame from their normal.
+/// Unreferenced vertices and vertices whose neighbourhood cannot be fitted (fewer than 5
+/// neighbours in their whole component, degenerate geometry) get `k1 = k2 = 0` and a frame from
+/// their normal.
 /// Deterministic; parallel over vertices.
 ///
 /// Errors: [`MetricError::Mesh`] if the mesh is empty or a coordinate is not finite.
