@@ -65,6 +65,9 @@ pub struct PrincipalCurvature {
 /// of the fit: such vertices are planar, their directions undefined.
 const PLANAR_RELATIVE: f64 = 1e-9;
 
+/// A neighbour "faces" the vertex when the cosine between their normals exceeds this.
+const FACING_MIN_COS: f64 = 1e-9;
+
 /// Minimum number of neighbours (besides the vertex) for a fit; libigl asks for 6 points
 /// including the vertex itself.
 const MIN_NEIGHBOURS: usize = 5;
@@ -212,11 +215,14 @@ fn fit_vertex(
     }
     let n0 = n0.normalize();
     // libigl's `projectionPlaneCheck`: drop neighbours facing away (normal more than 90° from
-    // n₀), e.g. across a sharp feature line, when enough remain and some were dropped.
+    // n₀), e.g. across a sharp feature line, when enough remain and some were dropped. libigl's
+    // test is `> 0`; we ask for `> FACING_MIN_COS` so that neighbours at exactly 90° (common on
+    // symmetric meshes: a torus's equator seen from its top circle) are dropped whatever the
+    // round-off, instead of flipping in and out with the mesh's placement and scale.
     let facing: Vec<u32> = ring
         .iter()
         .copied()
-        .filter(|&w| normals[w as usize].dot(&n0) > 0.0)
+        .filter(|&w| normals[w as usize].dot(&n0) > FACING_MIN_COS)
         .collect();
     let ring: &[u32] = if facing.len() >= MIN_NEIGHBOURS && facing.len() < ring.len() {
         &facing
