@@ -257,3 +257,44 @@ fn unreferenced_vertices_do_not_break_curvature_or_field() -> R {
     assert!(last.iter().all(|x| x.is_finite()));
     Ok(())
 }
+
+#[test]
+fn principal_curvatures_are_deterministic() -> R {
+    let m = generators::torus(1.0, 0.4, 40, 20);
+    let bits = |v: &[conemesh::metric::PrincipalCurvature]| -> Vec<u64> {
+        v.iter()
+            .flat_map(|c| {
+                [c.k1, c.k2, c.d1.x, c.d1.y, c.d1.z, c.normal.x]
+                    .map(f64::to_bits)
+                    .to_vec()
+            })
+            .collect()
+    };
+    let a = principal_curvatures(&m, &CurvatureOptions::default())?;
+    let b = principal_curvatures(&m, &CurvatureOptions::default())?;
+    assert_eq!(bits(&a), bits(&b));
+    Ok(())
+}
+
+#[test]
+fn tiny_components_get_zero_curvature_and_a_valid_field() -> R {
+    // One triangle: two neighbours per vertex, too few for the 5-parameter fit.
+    let m = TriMesh::from_indices(
+        vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, 1.0, 0.2),
+        ],
+        &[[0, 1, 2]],
+    )?;
+    let pc = principal_curvatures(&m, &CurvatureOptions::default())?;
+    let n = m.face_normal(FaceId(0));
+    for c in &pc {
+        assert_eq!((c.k1, c.k2), (0.0, 0.0));
+        assert!((c.normal - n).norm() < 1e-12);
+    }
+    let field = MetricField::from_curvature(m, &MetricOptions::default())?;
+    let at = field.eval(&Point3::new(0.2, 0.2, 1.0));
+    assert!((at * n).norm() < 1e-15);
+    Ok(())
+}

@@ -111,7 +111,12 @@ fn compare(mesh: &str, reference: &str) -> Result<Agreement, Box<dyn std::error:
     let refs = read_reference(&format!("{REFERENCE}/{reference}"))?;
     assert_eq!(refs.len(), m.n_vertices(), "{mesh}: reference vertex count");
     let norm = Normalization::of(&m);
+    let t = std::time::Instant::now();
     let ours = principal_curvatures(&norm.apply(&m), &CurvatureOptions { radius: 5 })?;
+    eprintln!(
+        "{mesh}: principal_curvatures {:.3} s",
+        t.elapsed().as_secs_f64()
+    );
     let diag = m.bbox_diagonal();
     let (mut n_umb, mut dir_ok) = (0usize, 0usize);
     let (mut err_max, mut err_min) = (Vec::new(), Vec::new());

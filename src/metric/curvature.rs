@@ -13,8 +13,9 @@
 //!    term, the surface passes through `v`) is fitted to the neighbours' frame coordinates by
 //!    least squares (SVD, coordinates scaled by the neighbourhood size for conditioning);
 //! 4. the principal curvatures are (minus) the eigenvalues of the fitted surface's shape operator
-//!    `I⁻¹ II` at `v`, symmetrised as libigl does, and the principal directions its eigenvectors
-//!    mapped to 3D in the tangent plane of `n₀` (`t₁ x¹ + t₂ x²`), as libigl does.
+//!    `I⁻¹ II` at `v` (libigl uses a symmetrised approximation, see `paper-notes.md`), and `d₁`
+//!    is its eigenvector for `k₁` mapped to 3D and projected on the tangent plane of `n₀`, as libigl
+//!    reports directions; `d₂ = n₀ × d₁`.
 //!
 //! Sign: `k > 0` where the surface bends away from its normal (a sphere with outward normals has
 //! `k₁ = k₂ = +1/r`), as in libigl.
@@ -63,6 +64,9 @@ pub struct PrincipalCurvature {
 /// Curvature magnitudes below `PLANAR_RELATIVE / h` (h = neighbourhood size) are numerical noise
 /// of the fit: such vertices are planar, their directions undefined.
 const PLANAR_RELATIVE: f64 = 1e-9;
+
+/// A neighbour "faces" the vertex when the cosine between their normals exceeds this.
+const FACING_MIN_COS: f64 = 1e-9;
 
 /// Minimum number of neighbours (besides the vertex) for a fit; libigl asks for 6 points
 /// including the vertex itself.
@@ -206,16 +210,19 @@ fn fit_vertex(
     // Frame normal: the vertex's own area-weighted normal (libigl's default, `localMode` with
     // `AVERAGE` normals).
     let n0 = normals[v];
-    if !n0.norm().is_finite() || n0.norm() <= 0.0 || ring.len() < 2 {
+    if !n0.norm().is_finite() || n0.norm() <= 0.0 || ring.len() < MIN_NEIGHBOURS {
         return planar(n0);
     }
     let n0 = n0.normalize();
     // libigl's `projectionPlaneCheck`: drop neighbours facing away (normal more than 90° from
-    // n₀), e.g. across a sharp feature line, when enough remain and some were dropped.
+    // n₀), e.g. across a sharp feature line, when enough remain and some were dropped. libigl's
+    // test is `> 0`; we ask for `> FACING_MIN_COS` so that neighbours at exactly 90° (common on
+    // symmetric meshes: a torus's equator seen from its top circle) are dropped whatever the
+    // round-off, instead of flipping in and out with the mesh's placement and scale.
     let facing: Vec<u32> = ring
         .iter()
         .copied()
-        .filter(|&w| normals[w as usize].dot(&n0) > 0.0)
+        .filter(|&w| normals[w as usize].dot(&n0) > FACING_MIN_COS)
         .collect();
     let ring: &[u32] = if facing.len() >= MIN_NEIGHBOURS && facing.len() < ring.len() {
         &facing
@@ -267,19 +274,28 @@ fn fit_vertex(
     let w = (1.0 + d * d + e * e).sqrt();
     let (ee, ff, gg) = (1.0 + d * d, d * e, 1.0 + e * e);
     let (l, m_, nn) = (2.0 * a / w, b / w, 2.0 * c / w);
-    // Shape operator I⁻¹ II, symmetrised as libigl does (its off-diagonal M E − L F on both
-    // sides; exact when d = e = 0, i.e. when the vertex normal is the fitted normal, and off by
-    // O(d² + e²) otherwise). The symmetric form keeps the principal directions orthogonal in the
-    // tangent plane of the vertex normal n₀, which is where the metric is used (Sec. 4.1 builds
-    // M from (d₁, d₂, d₁ × d₂); Eq. 4 projects onto the plane of d₁, d₂).
-    let off = m_ * ee - l * ff;
-    let shape = Matrix2::new(l * gg - m_ * ff, off, off, nn * ee - m_ * ff) / (ee * gg - ff * ff);
-    let eig = SymmetricEigen::new(shape);
+    // Principal curvatures: eigenvalues of the shape operator I⁻¹ II (the generalised symmetric
+    // problem II x = λ I x, solved through the Cholesky factor I = R Rᵀ: S = R⁻¹ II R⁻ᵀ,
+    // x = R⁻ᵀ y). libigl symmetrises I⁻¹ II instead (its off-diagonal M E − L F on both sides),
+    // which is exact only when d = e = 0 and then depends on the frame's tangent axis; the exact
+    // operator does not, so the result is independent of how (t₁, t₂) is chosen.
+    let r11 = ee.sqrt();
+    let r21 = ff / r11;
+    let r22 = (gg - r21 * r21).sqrt();
+    let Some(r_inv) = Matrix2::new(r11, 0.0, r21, r22).try_inverse() else {
+        return planar(n0);
+    };
+    let second = Matrix2::new(l, m_, m_, nn);
+    let s = r_inv * second * r_inv.transpose();
+    let eig = SymmetricEigen::new((s + s.transpose()) * 0.5);
     // k = −λ: the graph of a sphere seen from its outward normal has f = −(u²+v²)/2r, λ = −1/r.
+    // Directions: the 3D tangent x_u x¹ + x_v x² = (t₁ + d n₀) x¹ + (t₂ + e n₀) x², projected on
+    // the tangent plane of n₀ (as libigl reports them), where the metric lives (Sec. 4.1 builds
+    // M from (d₁, d₂, d₁ × d₂); Eq. 4 projects onto the plane of d₁, d₂).
     let mut pairs: Vec<(f64, Vector3<f64>)> = (0..2)
         .map(|i| {
-            let y = eig.eigenvectors.column(i);
-            (-eig.eigenvalues[i], t1 * y[0] + t2 * y[1])
+            let x = r_inv.transpose() * eig.eigenvectors.column(i);
+            (-eig.eigenvalues[i], t1 * x[0] + t2 * x[1])
         })
         .collect();
     pairs.sort_by(|p, q| {
@@ -315,8 +331,9 @@ fn fit_vertex(
 /// `opts.radius` rings, see the module doc). Shapes: one entry per vertex, in vertex order.
 /// Units: curvature in 1/(mesh units); callers pass the unit-space mesh (Sec. 3.1 notes).
 ///
-/// Unreferenced vertices and vertices whose neighbourhood cannot be fitted (fewer than two
-/// neighbours, degenerate geometry) get `k1 = k2 = 0` and a frame from their normal.
+/// Unreferenced vertices and vertices whose neighbourhood cannot be fitted (fewer than 5
+/// neighbours in their whole component, degenerate geometry) get `k1 = k2 = 0` and a frame from
+/// their normal.
 /// Deterministic; parallel over vertices.
 ///
 /// Errors: [`MetricError::Mesh`] if the mesh is empty or a coordinate is not finite.
@@ -393,6 +410,46 @@ mod tests {
         assert!((apex.k2 - 1.0 / r2).abs() < 0.01 / r2, "{apex:?}");
         assert!(apex.d1.x.abs() > 0.999, "{apex:?}");
         assert!(apex.normal.z > 0.999, "{apex:?}");
+        Ok(())
+    }
+
+    fn wedge(angle: f64) -> Result<TriMesh, MetricError> {
+        // A crease z = −0.3x (x > 0), z = 1.2x (x < 0), plus a y² bend: at the crease the vertex
+        // normal is far from the fitted surface's normal (d, e ≠ 0 in the frame).
+        let (c, s) = (angle.cos(), angle.sin());
+        let nx = 21;
+        let mut pos = Vec::new();
+        for j in 0..nx {
+            for i in 0..nx {
+                let x = (i as f64 - 10.0) * 0.01;
+                let y = (j as f64 - 10.0) * 0.01;
+                let z = if x > 0.0 { -0.3 * x } else { 1.2 * x } - y * y;
+                pos.push(nalgebra::Point3::new(c * x - s * y, s * x + c * y, z));
+            }
+        }
+        let mut tris = Vec::new();
+        for j in 0..nx - 1 {
+            for i in 0..nx - 1 {
+                let a = j * nx + i;
+                tris.push([a, a + 1, a + nx + 1]);
+                tris.push([a, a + nx + 1, a + nx]);
+            }
+        }
+        Ok(TriMesh::from_indices(pos, &tris)?)
+    }
+
+    #[test]
+    fn curvatures_do_not_depend_on_the_frame_tangent_axis_at_a_crease() -> Result<(), MetricError> {
+        // Deliberate difference to libigl (paper-notes § 3.1): the exact shape operator is
+        // independent of the tangent axis of the fitting frame; libigl's symmetrised one is not
+        // when the vertex normal differs from the fitted normal. Rotating the mesh about z changes
+        // which axis `tangent_frame` picks relative to the surface.
+        let centre = 10 * 21 + 10;
+        let a = principal_curvatures(&wedge(0.0)?, &CurvatureOptions::default())?[centre];
+        let b = principal_curvatures(&wedge(0.5)?, &CurvatureOptions::default())?[centre];
+        assert!(a.k1.abs() > 1.0, "{a:?}");
+        assert!((a.k1 - b.k1).abs() < 1e-9 * a.k1.abs(), "{a:?} {b:?}");
+        assert!((a.k2 - b.k2).abs() < 1e-9 * a.k1.abs(), "{a:?} {b:?}");
         Ok(())
     }
 }
