@@ -19,7 +19,9 @@
 
 use super::distortion::{jacobian, triangle_frames, TriangleFrame};
 use super::tutte::{certified_tutte, scale_to_area, TutteWeights};
-use super::{certify, distortion, validate_disk, ParamError, Parameterization, Parameterizer};
+use super::{
+    certify, distortion, recertify, validate_disk, ParamError, Parameterization, Parameterizer,
+};
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
 use faer::linalg::solvers::Solve;
@@ -542,7 +544,7 @@ pub fn optimize_with_log(
             }
             let e = prob.energy(&trial);
             if e <= energy + options.armijo * t * slope {
-                if certify(disk, &trial, boundary).is_ok() {
+                if recertify(disk, &trial, boundary).is_ok() {
                     accepted = Some(e);
                     break;
                 }
@@ -563,7 +565,7 @@ pub fn optimize_with_log(
                     );
                 }
                 let e = prob.energy(&probe);
-                if !(e < e_best) || certify(disk, &probe, boundary).is_err() {
+                if !(e < e_best) || recertify(disk, &probe, boundary).is_err() {
                     break;
                 }
                 e_best = e;
