@@ -563,7 +563,8 @@ pub fn optimize_with_log(
         let dir: Vec<f64> = (0..dim).map(|i| sol[(i, 0)]).collect();
         let slope: f64 = dir.iter().zip(&grad).map(|(d, g)| d * g).sum();
         log.time_ms[2] += lap();
-        if !(slope < 0.0) {
+        // NaN-safe: a NaN slope also means no usable descent direction.
+        if slope.is_nan() || slope >= 0.0 {
             converged = true; // no descent direction left
             break;
         }
@@ -597,7 +598,7 @@ pub fn optimize_with_log(
                     );
                 }
                 let e = prob.energy(&probe);
-                if !(e < e_best) || recertify(disk, &probe, boundary).is_err() {
+                if e.is_nan() || e >= e_best || recertify(disk, &probe, boundary).is_err() {
                     break;
                 }
                 e_best = e;
@@ -646,7 +647,18 @@ impl Parameterizer for SymmetricDirichlet {
     ) -> Result<Parameterization, ParamError> {
         validate_disk(disk, boundary)?;
         let (uv0, _) = certified_tutte(disk, boundary, self.options.init_weights)?;
-        let (mut uv, log) = optimize_with_log(disk, boundary, &uv0, &self.options)?;
+        // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
+        // finite float energy, or a failed factorisation), the certified Tutte map is returned.
+        let (mut uv, log) = match optimize_with_log(disk, boundary, &uv0, &self.options) {
+            Ok(r) => r,
+            Err(_) => (
+                uv0,
+                SdLog {
+                    fell_back: true,
+                    ..Default::default()
+                },
+            ),
+        };
         let mut fell_back = log.fell_back;
         // Isometric in the mean: rescale so the 2D area equals the 3D area; a uniform scale
         // keeps orientations in exact arithmetic, and the certificate is re-checked.
