@@ -120,6 +120,36 @@ pub fn certify_bijective(
             "the triangles have {n_boundary_half_edges} boundary edges, the loop has {m}"
         )));
     }
+    certify_embedding_geometry(uv, boundary)
+}
+
+/// Steps 3 and 4 of [`certify_bijective`] (after step 1 on the triangles) for a caller that
+/// has already checked that `boundary` is the boundary loop of its triangles and that every
+/// index is in range: the optimiser's line search, where only positions change.
+pub(crate) fn certify_map_of_known_disk(
+    uv: &[Point2<f64>],
+    triangles: &[[VertexId; 3]],
+    boundary: &[VertexId],
+) -> Result<(), InvariantError> {
+    if uv.iter().any(|p| !(p.x.is_finite() && p.y.is_finite())) {
+        return Err(not_bijective("a uv position is not finite".to_string()));
+    }
+    let bad = non_positive_faces(uv, triangles);
+    if !bad.is_empty() {
+        return Err(not_bijective(format!(
+            "non-positive (flipped or degenerate) triangles: {}",
+            Offenders(bad)
+        )));
+    }
+    certify_embedding_geometry(uv, boundary)
+}
+
+/// Simple, counter-clockwise boundary polygon (steps 3 and 4); `boundary.len() ≥ 3`.
+fn certify_embedding_geometry(
+    uv: &[Point2<f64>],
+    boundary: &[VertexId],
+) -> Result<(), InvariantError> {
+    let m = boundary.len();
     // 3. Simple boundary polygon.
     let p = |i: usize| &uv[boundary[i % m].idx()];
     let edge = |i: usize| [boundary[i % m], boundary[(i + 1) % m]];

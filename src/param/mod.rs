@@ -141,6 +141,17 @@ pub fn disk_boundary(disk: &TriMesh) -> Result<Vec<VertexId>, ParamError> {
     Ok(b)
 }
 
+/// Certify a new map of a disk whose triangles and boundary loop `certify` has already
+/// accepted once (positions only: orientation, simple CCW boundary).
+pub(crate) fn recertify(
+    disk: &TriMesh,
+    uv: &[Point2<f64>],
+    boundary: &[VertexId],
+) -> Result<(), ParamError> {
+    crate::invariants::certify_map_of_known_disk(uv, &disk.triangles, boundary)
+        .map_err(|e| ParamError::NotCertified(e.to_string()))
+}
+
 /// Certify a map and turn a failure into [`ParamError::NotCertified`].
 pub(crate) fn certify(
     disk: &TriMesh,

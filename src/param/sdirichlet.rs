@@ -19,13 +19,15 @@
 
 use super::distortion::{jacobian, triangle_frames, TriangleFrame};
 use super::tutte::{certified_tutte, scale_to_area, TutteWeights};
-use super::{certify, distortion, validate_disk, ParamError, Parameterization, Parameterizer};
+use super::{
+    certify, distortion, recertify, validate_disk, ParamError, Parameterization, Parameterizer,
+};
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::factorize_symbolic_cholesky;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Mat, Side};
+use faer::{Conj, Mat, Par, Side};
 use nalgebra::{Matrix4, Point2, Vector2, Vector4};
 
 /// Options of [`SymmetricDirichlet`] (defaults in brackets).
@@ -325,17 +327,23 @@ impl Problem<'_> {
                 }
             }
             let slots = &pat.tri_slots[ti];
-            for l1 in 0..6 {
-                let (k, i) = (l1 / 2, l1 % 2);
-                for l2 in 0..6 {
-                    let (l, m) = (l2 / 2, l2 % 2);
-                    let mut s = 0.0;
-                    for jj in 0..2 {
-                        for pp in 0..2 {
-                            s += hf[(2 * i + jj, 2 * m + pp)] * g[k][jj] * g[l][pp];
+            // Block (i, m) of the 6×6 Hessian over corners: G · H_F[2i.., 2m..] · Gᵀ (3×3).
+            for i in 0..2 {
+                for m in 0..2 {
+                    let hb = [
+                        [hf[(2 * i, 2 * m)], hf[(2 * i, 2 * m + 1)]],
+                        [hf[(2 * i + 1, 2 * m)], hf[(2 * i + 1, 2 * m + 1)]],
+                    ];
+                    for k in 0..3 {
+                        let tk = [
+                            w * (g[k][0] * hb[0][0] + g[k][1] * hb[1][0]),
+                            w * (g[k][0] * hb[0][1] + g[k][1] * hb[1][1]),
+                        ];
+                        for l in 0..3 {
+                            let v = tk[0] * g[l][0] + tk[1] * g[l][1];
+                            vals[slots[(2 * k + i) * 6 + 2 * l + m] as usize] += v;
                         }
                     }
-                    vals[slots[l1 * 6 + l2] as usize] += w * s;
                 }
             }
         }
@@ -481,8 +489,19 @@ pub fn optimize_with_log(
     let pat = Pattern::new(n, &disk.triangles);
     let dim = 2 * n;
     let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
-    let symbolic = SymbolicLlt::try_new(sym, Side::Lower)
-        .map_err(|e| ParamError::Solver(format!("symbolic Cholesky: {e:?}")))?;
+    // One symbolic factorisation (AMD ordering) for all iterations. Sequential: patches are
+    // parameterized in parallel by the caller, and small factorisations gain nothing from
+    // threads on a loaded machine.
+    let symbolic =
+        factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
+            .map_err(|e| ParamError::Solver(format!("symbolic Cholesky: {e:?}")))?;
+    let mut l_values = vec![0.0; symbolic.len_val()];
+    let mut mem = MemBuffer::new(
+        symbolic
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+    );
+    let mut shifted = vec![0.0; pat.row_idx.len()];
     log.time_ms[0] += lap();
     let mut vals = vec![0.0; pat.row_idx.len()];
     let mut grad = vec![0.0; dim];
@@ -503,33 +522,49 @@ pub fn optimize_with_log(
             .map(|v| vals[pat.diag_slots[v / 2][if v % 2 == 0 { 0 } else { 3 }] as usize])
             .sum();
         let mut mu = 1e-8 * trace / dim as f64;
-        let mut llt = None;
+        let mut sol = Mat::<f64>::zeros(dim, 1);
+        let mut factored = false;
         for _ in 0..8 {
-            let mut v = vals.clone();
+            shifted.copy_from_slice(&vals);
             for vv in 0..n {
-                v[pat.diag_slots[vv][0] as usize] += mu;
-                v[pat.diag_slots[vv][3] as usize] += mu;
+                shifted[pat.diag_slots[vv][0] as usize] += mu;
+                shifted[pat.diag_slots[vv][3] as usize] += mu;
             }
-            let mat = SparseColMatRef::new(sym, &v);
+            let mat = SparseColMatRef::new(sym, &shifted);
             log.factorizations += 1;
-            if let Ok(f) = Llt::try_new_with_symbolic(symbolic.clone(), mat, Side::Lower) {
-                llt = Some(f);
+            if let Ok(llt) = symbolic.factorize_numeric_llt::<f64>(
+                &mut l_values,
+                mat,
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut mem),
+                Default::default(),
+            ) {
+                for i in 0..dim {
+                    sol[(i, 0)] = -grad[i];
+                }
+                llt.solve_in_place_with_conj(
+                    Conj::No,
+                    sol.as_mut(),
+                    Par::Seq,
+                    MemStack::new(&mut mem),
+                );
+                factored = true;
                 break;
             }
             mu *= 100.0;
         }
-        let llt = llt.ok_or_else(|| {
-            ParamError::Solver("Newton Hessian is not positive definite".to_string())
-        })?;
-        let mut rhs = Mat::<f64>::zeros(dim, 1);
-        for i in 0..dim {
-            rhs[(i, 0)] = -grad[i];
+        if !factored {
+            return Err(ParamError::Solver(
+                "Newton Hessian is not positive definite".to_string(),
+            ));
         }
-        let sol = llt.solve(&rhs);
         let dir: Vec<f64> = (0..dim).map(|i| sol[(i, 0)]).collect();
         let slope: f64 = dir.iter().zip(&grad).map(|(d, g)| d * g).sum();
         log.time_ms[2] += lap();
-        if !(slope < 0.0) {
+        // NaN-safe: a NaN slope also means no usable descent direction.
+        if slope.is_nan() || slope >= 0.0 {
             converged = true; // no descent direction left
             break;
         }
@@ -542,7 +577,7 @@ pub fn optimize_with_log(
             }
             let e = prob.energy(&trial);
             if e <= energy + options.armijo * t * slope {
-                if certify(disk, &trial, boundary).is_ok() {
+                if recertify(disk, &trial, boundary).is_ok() {
                     accepted = Some(e);
                     break;
                 }
@@ -563,7 +598,7 @@ pub fn optimize_with_log(
                     );
                 }
                 let e = prob.energy(&probe);
-                if !(e < e_best) || certify(disk, &probe, boundary).is_err() {
+                if e.is_nan() || e >= e_best || recertify(disk, &probe, boundary).is_err() {
                     break;
                 }
                 e_best = e;
@@ -612,7 +647,18 @@ impl Parameterizer for SymmetricDirichlet {
     ) -> Result<Parameterization, ParamError> {
         validate_disk(disk, boundary)?;
         let (uv0, _) = certified_tutte(disk, boundary, self.options.init_weights)?;
-        let (mut uv, log) = optimize_with_log(disk, boundary, &uv0, &self.options)?;
+        // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
+        // finite float energy, or a failed factorisation), the certified Tutte map is returned.
+        let (mut uv, log) = match optimize_with_log(disk, boundary, &uv0, &self.options) {
+            Ok(r) => r,
+            Err(_) => (
+                uv0,
+                SdLog {
+                    fell_back: true,
+                    ..Default::default()
+                },
+            ),
+        };
         let mut fell_back = log.fell_back;
         // Isometric in the mean: rescale so the 2D area equals the 3D area; a uniform scale
         // keeps orientations in exact arithmetic, and the certificate is re-checked.

@@ -127,7 +127,7 @@ fn weights(disk: &TriMesh, kind: TutteWeights) -> Vec<(usize, usize, f64)> {
     }
     if kind == TutteWeights::Cotan {
         // Clamp non-positive (non-Delaunay) weights to a small positive floor, per edge sum.
-        out.sort_unstable_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
+        out.sort_unstable_by_key(|x| (x.0, x.1));
         let mut merged: Vec<(usize, usize, f64)> = Vec::with_capacity(out.len() / 2);
         for (i, j, w) in out {
             match merged.last_mut() {
