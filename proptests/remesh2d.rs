@@ -70,7 +70,7 @@ proptest! {
             "proptests/regressions/remesh2d.txt",
         ))),
         // Fixed cases: the quality thresholds are properties of these 24 inputs, not flaky draws.
-        rng_seed: proptest::test_runner::RngSeed::Fixed(0x5eed_2d),
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x005e_ed2d),
         ..Default::default()
     })]
 

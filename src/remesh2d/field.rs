@@ -315,10 +315,7 @@ mod tests {
                     Some(tri),
                     (0..f.triangles().len()).find(|&q| f.contains(q, &m))
                 );
-                assert!(
-                    l.iter().any(|&x| x == 0.0),
-                    "edge point has a zero coordinate"
-                );
+                assert!(l.contains(&0.0), "edge point has a zero coordinate");
             }
         }
         // Outside.
