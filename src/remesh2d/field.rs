@@ -336,6 +336,13 @@ mod tests {
     }
 
     #[test]
+    fn field_is_send_sync() {
+        fn check<T: Send + Sync>() {}
+        check::<PlanarMetricField>();
+        check::<crate::remesh2d::Lct>();
+    }
+
+    #[test]
     fn rejects_clockwise_triangles() {
         let pts = vec![
             Point2::new(0.0, 0.0),
