@@ -140,3 +140,36 @@ fn mismatched_boundaries_and_extreme_anisotropy_stay_certified() -> Result<(), R
     }
     Ok(())
 }
+
+/// Smallest inputs: one triangle (nothing to do), a quad with one interior chord.
+#[test]
+fn tiny_domains() -> Result<(), Remesh2dError> {
+    let tri = PlanarDomain {
+        points: vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(1.0, 0.0),
+            Point2::new(0.0, 1.0),
+        ],
+        triangles: vec![[0, 1, 2]],
+        boundary: vec![0, 1, 2],
+        constrained_edges: vec![],
+    };
+    let out = Lct::default().remesh(&tri, &Iso, 0.1, &mut ChaCha8Rng::seed_from_u64(0))?;
+    assert_eq!(out.triangles.len(), 1);
+    let quad = PlanarDomain {
+        points: vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(1.0, 0.0),
+            Point2::new(1.0, 1.0),
+            Point2::new(0.0, 1.0),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        boundary: vec![0, 1, 2, 3],
+        constrained_edges: vec![],
+    };
+    for l in [0.05, 1.0, 10.0] {
+        let out = Lct::default().remesh(&quad, &Iso, l, &mut ChaCha8Rng::seed_from_u64(0))?;
+        certify_planar(&quad, &out)?;
+    }
+    Ok(())
+}
