@@ -1,7 +1,7 @@
-//! The LCT planar remesher (Sec. 3.3, ref. [5]: Fu, Liu, Snyder, Guo 2014, "Anisotropic
+//! The LCT planar remesher (Sec. 3.3, ref. \[5\]: Fu, Liu, Snyder, Guo 2014, "Anisotropic
 //! simplicial meshing using local convex functions").
 //!
-//! Energy (the local convex function energy of [5], written in paper-notes.md): every vertex
+//! Energy (the local convex function energy of \[5\], written in paper-notes.md): every vertex
 //! `v` carries the convex function `f_v(x) = ½ (x − v)ᵀ M_v (x − v)`; the energy is the L1 error
 //! of its piecewise-linear interpolation, summed over vertices and their 1-rings, which on one
 //! triangle `T` (Euclidean area `|T|` in the parameter plane) is in closed form
