@@ -3,6 +3,7 @@
 //! (`--big`: also time a ~20,000-triangle output).
 
 use conemesh::remesh2d::{demo_cases, run_demo_case, DemoDomain, DemoMetric};
+use std::io::Write;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -17,11 +18,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cases.push((DemoDomain::Square, DemoMetric::UniformIsotropic, 0.0107));
     }
     let mut rows = Vec::new();
+    let mut out = std::io::stdout().lock();
     if !json {
-        println!(
+        writeln!(
+            out,
             "{:<8} {:<15} {:>6} {:>6} {:>6} {:>6} {:>11} {:>11} {:>8} {:>8}",
             "domain", "metric", "L", "V", "F", "q_min", "q_avg", "θ_min", "θ_avg", "in-range"
-        );
+        )?;
     }
     for (d, m, l) in cases {
         let t0 = Instant::now();
@@ -33,7 +36,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "quality": q,
             }));
         } else {
-            println!(
+            writeln!(
+                out,
                 "{:<8} {:<15} {:>6} {:>6} {:>6} {:>6.3} {:>11.3} {:>10.2}° {:>7.2}° {:>7.1}%   ({secs:.2} s)",
                 d.name(),
                 m.name(),
@@ -45,11 +49,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 q.theta_min_deg,
                 q.theta_avg_deg,
                 100.0 * q.edges_in_range
-            );
+            )?;
         }
     }
     if json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        writeln!(out, "{}", serde_json::to_string_pretty(&rows)?)?;
     }
     Ok(())
 }

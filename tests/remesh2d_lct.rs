@@ -111,3 +111,65 @@ fn refuses_bad_input() -> Result<(), Remesh2dError> {
     );
     Ok(())
 }
+
+/// The patch boundary of the pipeline is whatever the input mesh has: much finer or much
+/// coarser than L, and metrics far from isotropic. The result must stay certified.
+#[test]
+fn mismatched_boundaries_and_extreme_anisotropy_stay_certified() -> Result<(), Remesh2dError> {
+    struct Needle;
+    impl Metric2d for Needle {
+        fn metric(&self, _: &Point2<f64>) -> Matrix2<f64> {
+            let th: f64 = 0.3;
+            let r = Matrix2::new(th.cos(), -th.sin(), th.sin(), th.cos());
+            r * Matrix2::new(1.0, 0.0, 0.0, 1e4) * r.transpose()
+        }
+    }
+    let cases: [(f64, &dyn Metric2d, f64); 4] = [
+        (0.02, &Iso, 0.3),   // boundary 15× finer than L
+        (0.5, &Iso, 0.05),   // boundary 10× coarser than L
+        (0.1, &Needle, 1.0), // anisotropy 100 in lengths, boundary not adapted
+        (0.25, &Shear, 0.3),
+    ];
+    for (i, (spacing, metric, l)) in cases.into_iter().enumerate() {
+        let dom = square_domain(&Iso, spacing)?;
+        let out =
+            Lct::default().remesh(&dom, metric, l, &mut ChaCha8Rng::seed_from_u64(i as u64))?;
+        certify_planar(&dom, &out)?;
+        let kept = out.origin.iter().filter(|o| o.is_some()).count();
+        assert!(kept >= dom.boundary.len(), "case {i}");
+    }
+    Ok(())
+}
+
+/// Smallest inputs: one triangle (nothing to do), a quad with one interior chord.
+#[test]
+fn tiny_domains() -> Result<(), Remesh2dError> {
+    let tri = PlanarDomain {
+        points: vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(1.0, 0.0),
+            Point2::new(0.0, 1.0),
+        ],
+        triangles: vec![[0, 1, 2]],
+        boundary: vec![0, 1, 2],
+        constrained_edges: vec![],
+    };
+    let out = Lct::default().remesh(&tri, &Iso, 0.1, &mut ChaCha8Rng::seed_from_u64(0))?;
+    assert_eq!(out.triangles.len(), 1);
+    let quad = PlanarDomain {
+        points: vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(1.0, 0.0),
+            Point2::new(1.0, 1.0),
+            Point2::new(0.0, 1.0),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        boundary: vec![0, 1, 2, 3],
+        constrained_edges: vec![],
+    };
+    for l in [0.05, 1.0, 10.0] {
+        let out = Lct::default().remesh(&quad, &Iso, l, &mut ChaCha8Rng::seed_from_u64(0))?;
+        certify_planar(&quad, &out)?;
+    }
+    Ok(())
+}

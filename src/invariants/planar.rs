@@ -240,7 +240,9 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
             0.5 * (b - a).perp(&(c - a))
         })
         .sum();
-    if !((a_out - a_poly).abs() <= 1e-9 * a_poly.abs()) {
+    // Written so that a NaN area fails too.
+    let area_ok = (a_out - a_poly).abs() <= 1e-9 * a_poly.abs();
+    if !area_ok {
         return Err(invalid(format!(
             "total area {a_out} differs from the polygon's {a_poly}"
         )));

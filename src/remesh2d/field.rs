@@ -315,10 +315,7 @@ mod tests {
                     Some(tri),
                     (0..f.triangles().len()).find(|&q| f.contains(q, &m))
                 );
-                assert!(
-                    l.iter().any(|&x| x == 0.0),
-                    "edge point has a zero coordinate"
-                );
+                assert!(l.contains(&0.0), "edge point has a zero coordinate");
             }
         }
         // Outside.
@@ -336,6 +333,13 @@ mod tests {
         let m = f.metric(&Point2::new(2.0 + 1e-12, 1.0));
         assert!((m - Matrix2::new(3.0, 0.0, 0.0, 2.0)).norm() < 1e-9);
         Ok(())
+    }
+
+    #[test]
+    fn field_is_send_sync() {
+        fn check<T: Send + Sync>() {}
+        check::<PlanarMetricField>();
+        check::<crate::remesh2d::Lct>();
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! Planar anisotropic remeshing (Sec. 3.3): metric transfer (Eq. 4), the LCT remesher
-//! (ref. [5]) and the [`PlanarRemesher`] extension point.
+//! (ref. \[5\]) and the [`PlanarRemesher`] extension point.
 
 mod demo;
 mod domain;

@@ -78,7 +78,7 @@ pub fn planar_quality(
             let m = metric.metric(&mid);
             let e = pb - pa;
             let l = e.dot(&(m * e)).max(0.0).sqrt() / target_length;
-            l >= std::f64::consts::FRAC_1_SQRT_2 && l <= std::f64::consts::SQRT_2
+            (std::f64::consts::FRAC_1_SQRT_2..=std::f64::consts::SQRT_2).contains(&l)
         })
         .count();
     let nf = mesh.triangles.len().max(1) as f64;
