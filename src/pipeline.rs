@@ -119,7 +119,7 @@ impl Default for RemeshOptions {
         RemeshOptions {
             seed: 1,
             target: TargetLength::Factor(1.5),
-            transfer: TransferMethod::Eq4PrincipalFit,
+            transfer: TransferMethod::default(),
             check_self_intersections: true,
             debug_dir: None,
             max_patches: None,
