@@ -193,6 +193,11 @@ pub struct Certificate {
     pub no_flips: usize,
     /// Final mesh free of self-intersections (exact), 0 if not checked.
     pub no_self_intersections: usize,
+    /// Self-intersecting face pairs of the output; non-zero only when the input itself
+    /// self-intersects (otherwise the run fails).
+    pub self_intersecting_pairs: usize,
+    /// Self-intersecting face pairs of the input, computed only when the output has some.
+    pub input_self_intersecting_pairs: Option<usize>,
     /// Patches whose parameterizer fell back to its last certified iterate.
     pub param_fallbacks: usize,
 }
@@ -492,8 +497,27 @@ pub fn remesh(
     work.compact();
     let t0 = Instant::now();
     if options.check_self_intersections {
-        invariants::certify_no_self_intersections(&work.mesh).map_err(PipelineError::Final)?;
-        cert.no_self_intersections = 1;
+        let pairs = invariants::self_intersections(&work.mesh);
+        if pairs.is_empty() {
+            cert.no_self_intersections = 1;
+        } else {
+            // An input that itself self-intersects (cow.off does, at 118 face pairs) cannot
+            // give an embedded output that lies on it; that is reported, not an error. An
+            // embedded input must give an embedded output.
+            let input_pairs = invariants::self_intersections(reference).len();
+            if input_pairs == 0 {
+                return Err(PipelineError::Final(InvariantError::SelfIntersections(
+                    Offenders(
+                        pairs
+                            .into_iter()
+                            .map(|(a, b)| invariants::FacePair(a, b))
+                            .collect(),
+                    ),
+                )));
+            }
+            cert.self_intersecting_pairs = pairs.len();
+            cert.input_self_intersecting_pairs = Some(input_pairs);
+        }
     }
     times.final_check = t0.elapsed().as_secs_f64();
     let report = RemeshReport {
