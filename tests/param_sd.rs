@@ -158,3 +158,22 @@ fn certificate_names_flipped_triangles_and_self_overlapping_boundaries() {
         "{e}"
     );
 }
+
+#[test]
+fn running_out_of_budget_is_reported_not_an_error() {
+    let m = generators::cone_piece(0.6, 2.5, 0.4, 2.0, 20, 10);
+    let b = disk_boundary(&m).unwrap();
+    let tight = SymmetricDirichlet {
+        options: SdOptions {
+            max_iters: 1,
+            ..Default::default()
+        },
+    };
+    let p = tight.parameterize(&m, &b).unwrap();
+    certify_bijective(&p.uv, &m.triangles, &b).unwrap();
+    assert_eq!(p.report.iterations, 1);
+    assert!(p.report.hit_budget && !p.report.fell_back, "{:?}", p.report);
+    let full = SymmetricDirichlet::default().parameterize(&m, &b).unwrap();
+    assert!(!full.report.hit_budget);
+    assert!(full.report.symmetric_dirichlet < p.report.symmetric_dirichlet);
+}
