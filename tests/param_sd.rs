@@ -158,3 +158,52 @@ fn certificate_names_flipped_triangles_and_self_overlapping_boundaries() {
         "{e}"
     );
 }
+
+#[test]
+fn running_out_of_budget_is_reported_not_an_error() {
+    let m = generators::cone_piece(0.6, 2.5, 0.4, 2.0, 20, 10);
+    let b = disk_boundary(&m).unwrap();
+    let tight = SymmetricDirichlet {
+        options: SdOptions {
+            max_iters: 1,
+            ..Default::default()
+        },
+    };
+    let p = tight.parameterize(&m, &b).unwrap();
+    certify_bijective(&p.uv, &m.triangles, &b).unwrap();
+    assert_eq!(p.report.iterations, 1);
+    assert!(p.report.hit_budget && !p.report.fell_back, "{:?}", p.report);
+    let full = SymmetricDirichlet::default().parameterize(&m, &b).unwrap();
+    assert!(!full.report.hit_budget);
+    assert!(full.report.symmetric_dirichlet < p.report.symmetric_dirichlet);
+}
+
+#[test]
+fn tiny_disks_without_interior_vertices() {
+    let tri = TriMesh::from_indices(
+        vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(3.0, 0.0, 1.0),
+            Point3::new(0.0, 0.2, 0.0),
+        ],
+        &[[0, 1, 2]],
+    )
+    .unwrap();
+    let quad = TriMesh::from_indices(
+        vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(1.0, 1.0, 0.5),
+            Point3::new(0.0, 1.0, 0.0),
+        ],
+        &[[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    for m in [tri, quad] {
+        let b = disk_boundary(&m).unwrap();
+        let p = SymmetricDirichlet::default().parameterize(&m, &b).unwrap();
+        certify_bijective(&p.uv, &m.triangles, &b).unwrap();
+        // No interior vertex: the free boundary lets every triangle become isometric.
+        assert!(p.report.max_conformal < 1.001, "{:?}", p.report);
+    }
+}

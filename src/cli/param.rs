@@ -16,7 +16,7 @@ use std::time::Instant;
 pub enum Method {
     /// Symmetric Dirichlet, projected Newton with free boundary (the default).
     Sd,
-    /// Tutte's embedding on a circle (cotangent weights clamped positive).
+    /// Tutte's embedding on a circle (mean-value weights), scaled to the 3D area.
     Tutte,
 }
 
