@@ -27,6 +27,7 @@ use crate::patches::{extract_patch, ConePatches, DiskPatch, PatchContext, PatchS
 use crate::remesh2d::{
     transfer_metric, Lct, PlanarDomain, PlanarMetricField, PlanarRemesher, TransferMethod,
 };
+use crate::quality::FlipTest;
 use crate::stitch::{stitch, Replacement, WorkingMesh};
 use nalgebra::Matrix3;
 use rand::SeedableRng;
@@ -314,6 +315,7 @@ pub fn remesh(
         )));
     }
     let mut rng = crate::Rng::seed_from_u64(options.seed);
+    let flip_test = FlipTest::new(reference);
     let mut work = WorkingMesh::from_reference(reference);
     let ref_topo = Topology::build(reference);
     let signature = topology_signature(&ref_topo);
@@ -390,7 +392,7 @@ pub fn remesh(
             cert.disk += 1;
             times.patches += t0.elapsed().as_secs_f64();
             let attempt = remesh_patch(
-                field, stages, options, &work, &faces, l_tar, &mut rng, &mut times, &mut cert,
+                field, stages, options, &work, &flip_test, &faces, l_tar, &mut rng, &mut times, &mut cert,
             );
             match attempt {
                 Ok((replacement, distortion)) => {
@@ -630,6 +632,7 @@ fn remesh_patch(
     stages: &Stages,
     options: &RemeshOptions,
     work: &WorkingMesh,
+    flip_test: &FlipTest,
     faces: &[FaceId],
     l_tar: f64,
     rng: &mut crate::Rng,
@@ -711,7 +714,7 @@ fn remesh_patch(
 
     // (f) certify the candidate's new faces before touching the working mesh.
     let t0 = Instant::now();
-    let checked = certify_replacement(field, work, &replacement);
+    let checked = certify_replacement(flip_test, work, &replacement);
     times.certify += t0.elapsed().as_secs_f64();
     if let Err(e) = checked {
         let mut f = Failure::certificate("lifted faces", e);
@@ -772,7 +775,7 @@ fn shrink_patch(
 /// the reference surface (normal more than 90° from the normal of the reference face closest
 /// to the face's centroid).
 fn certify_replacement(
-    field: &MetricField,
+    flip_test: &FlipTest,
     work: &WorkingMesh,
     r: &Replacement,
 ) -> Result<(), InvariantError> {
@@ -792,10 +795,7 @@ fn certify_replacement(
             degenerate.push(f);
             continue;
         }
-        let n = (p[1] - p[0]).cross(&(p[2] - p[0]));
-        let c = nalgebra::Point3::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
-        let (loc, _) = field.project(&c);
-        if n.dot(&field.face_normal(loc.face)) <= 0.0 {
+        if flip_test.is_flipped(&p) {
             flipped.push(f);
         }
     }

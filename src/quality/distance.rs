@@ -170,27 +170,81 @@ pub fn approximation_error(
     }
 }
 
-/// Output faces whose normal points more than 90° away from the normal of the input face
-/// closest to the output face's centroid (the flip measure of the quality issue).
+/// The flip test of the quality issue, shared by `eval` and the pipeline's per-patch
+/// certificate so that both give the same verdict: a face is flipped when its normal points
+/// more than 90° away from the normal of the input face closest to its centroid.
 ///
-/// The decision is the sign of the float dot product of the two (unnormalised) face
-/// normals, strictly negative = flipped: a float decision on normals, not an exact
-/// predicate. It is only wrong for faces within rounding of 90° from the input, which are
-/// reported as not flipped; zero-area faces (zero normal) are never reported here (the
-/// degenerate-face certificate catches them). Where the centroid is equidistant from several
-/// input faces (a sharp edge), the one parry's BVH returns first is used.
+/// Ties: where the centroid's closest point lies on an input edge or vertex (a sharp crease:
+/// several input faces at the same distance), the closest face is not unique and "the" input
+/// normal is undefined; a face is then flipped only if it points away from every input face at
+/// that distance (faces around the closest face within a relative 1e-9 of the smallest
+/// distance, a measurement tolerance on distances, not an orientation decision).
+///
+/// The decision is the sign of the float dot product of the two (unnormalised) face normals,
+/// strictly negative = flipped: a float decision on normals, not an exact predicate. Zero-area
+/// faces (zero normal) are never reported here (the degenerate-face certificate catches them).
+pub struct FlipTest {
+    proj: SurfaceProjector,
+    input: TriMesh,
+    vertex_faces: Vec<Vec<FaceId>>,
+}
+
+impl FlipTest {
+    /// Index the input surface.
+    pub fn new(input: &TriMesh) -> FlipTest {
+        let mut vertex_faces = vec![Vec::new(); input.n_vertices()];
+        for (f, t) in input.triangles.iter().enumerate() {
+            for v in t {
+                vertex_faces[v.idx()].push(FaceId::new(f));
+            }
+        }
+        FlipTest {
+            proj: SurfaceProjector::new(input),
+            input: input.clone(),
+            vertex_faces,
+        }
+    }
+
+    /// Is the triangle `p` (counter-clockwise seen from outside) flipped against the input?
+    pub fn is_flipped(&self, p: &[Point3<f64>; 3]) -> bool {
+        let n_out: Vector3<f64> = (p[1] - p[0]).cross(&(p[2] - p[0]));
+        let c = Point3::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
+        let Some((fin, _, d)) = self.proj.closest(&c) else {
+            return false;
+        };
+        if n_out.dot(&self.input.face_normal_raw(fin)) >= 0.0 {
+            return false;
+        }
+        // The closest face disagrees: look for an equally close input face that agrees.
+        let tol = d * 1e-9 + f64::MIN_POSITIVE;
+        for v in self.input.face(fin) {
+            for &g in &self.vertex_faces[v.idx()] {
+                if g == fin {
+                    continue;
+                }
+                let [a, b, e] = self.input.face_points(g);
+                let tri = parry3d_f64::shape::Triangle::new(
+                    PVec::new(a.x, a.y, a.z),
+                    PVec::new(b.x, b.y, b.z),
+                    PVec::new(e.x, e.y, e.z),
+                );
+                use parry3d_f64::query::PointQuery;
+                let dg = tri.distance_to_local_point(PVec::new(c.x, c.y, c.z), false);
+                if dg <= d + tol && n_out.dot(&self.input.face_normal_raw(g)) >= 0.0 {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}
+
+/// Output faces flipped against the input ([`FlipTest`]).
 pub fn flips(input: &TriMesh, output: &TriMesh) -> Vec<FaceId> {
-    let proj = SurfaceProjector::new(input);
+    let test = FlipTest::new(input);
     let flagged: Vec<bool> = (0..output.n_faces())
         .into_par_iter()
-        .map(|i| {
-            let f = FaceId::new(i);
-            let n_out: Vector3<f64> = output.face_normal_raw(f);
-            match proj.closest(&output.face_centroid(f)) {
-                Some((fin, _, _)) => n_out.dot(&input.face_normal_raw(fin)) < 0.0,
-                None => false,
-            }
-        })
+        .map(|i| test.is_flipped(&output.face_points(FaceId::new(i))))
         .collect();
     flagged
         .iter()

@@ -11,7 +11,7 @@
 mod distance;
 mod eval;
 
-pub use distance::{approximation_error, flips, Distance, SurfaceProjector};
+pub use distance::{approximation_error, flips, Distance, FlipTest, SurfaceProjector};
 pub use eval::{evaluate, EvalOptions, EvalReport, EvalTimings, MeshSize, TargetLength};
 
 use crate::ids::{EdgeKey, VertexId};
