@@ -22,6 +22,7 @@
 //!   exp(-9π/2) ≈ 7e-7; within r of a vertex the vertex sample itself covers `x`). So
 //!   `d - δ <= conemesh <= d` with δ = 3·sqrt(A/N) (and the seed is fixed, so the test is
 //!   deterministic).
+//!
 //! Hence `cgal - δ <= conemesh <= cgal + H`, both up to a relative 1e-9 for the float
 //! evaluation of the point-triangle distances (different but equally exact formulas).
 //!
