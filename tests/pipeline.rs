@@ -3,8 +3,11 @@
 
 use conemesh::mesh::generators;
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
+use conemesh::patches::{ConePatches, Patch, PatchContext, PatchError, PatchStrategy};
 use conemesh::pipeline::{remesh, RemeshOptions, RemeshResult, Stages};
 use conemesh::{Topology, TriMesh};
+use rand_chacha::ChaCha8Rng;
+use std::sync::{Arc, Mutex};
 
 fn run(mesh: &TriMesh, seed: u64) -> (MetricField, RemeshResult) {
     let norm = Normalization::of(mesh);
@@ -32,42 +35,172 @@ fn run(mesh: &TriMesh, seed: u64) -> (MetricField, RemeshResult) {
     (field, result)
 }
 
+/// How many failed attempts (from `report.fallbacks.failures`, formatted
+/// `"{patch} ({n} faces): {stage}: {message}"`) got past each certificate before failing.
+/// An attempt runs, in order: certify_disk, parameterization (+ certify_bijective), metric
+/// transfer, planar remeshing (+ certify_planar), mapping back, lifted-face certificates.
+fn failures_past(r: &RemeshResult) -> (usize, usize) {
+    let stage_of = |f: &str| {
+        f.split_once("): ")
+            .map(|(_, rest)| rest.split(':').next().unwrap_or("").to_string())
+            .unwrap_or_default()
+    };
+    let mut past_param = 0;
+    let mut past_planar = 0;
+    for f in &r.report.fallbacks.failures {
+        match stage_of(f).as_str() {
+            "patch extraction" | "parameterization" => {}
+            "metric transfer" | "planar remeshing" => past_param += 1,
+            "mapping back" | "lifted faces" => {
+                past_param += 1;
+                past_planar += 1;
+            }
+            other => panic!("unknown failure stage `{other}` in `{f}`"),
+        }
+    }
+    (past_param, past_planar)
+}
+
 fn assert_certified(input: &TriMesh, field: &MetricField, r: &RemeshResult) {
     let c = &r.report.certificate;
     let n = r.report.patches;
     assert!(n > 0);
+    assert_eq!(r.report.patch_records.len(), n);
+    // Patches whose every attempt failed keep their faces unchanged (the retry ladder's last
+    // rung): they pass the working-mesh certificates but not the per-candidate ones.
+    let kept = r.report.patch_records.iter().filter(|p| p.kept).count();
+    let failures = r.report.fallbacks.failures.len();
+    let retries: usize = r.report.patch_records.iter().map(|p| p.retries).sum();
+    assert_eq!(
+        retries, failures,
+        "per-patch retries add up to the failures"
+    );
+    let kept_faces: usize = r
+        .report
+        .patch_records
+        .iter()
+        .filter(|p| p.kept)
+        .map(|p| p.unprocessed_in)
+        .sum();
+    assert_eq!(kept_faces, r.report.fallbacks.kept_faces);
+    let (past_param, past_planar) = failures_past(r);
+    let remeshed = n - kept;
+    // Once per patch, on the working mesh.
     for (name, count) in [
-        ("disk", c.disk),
-        ("bijective", c.bijective),
-        ("planar", c.planar),
         ("manifold", c.manifold),
         ("oriented", c.oriented),
         ("same_topology", c.same_topology),
         ("boundary_preserved", c.boundary_preserved),
-        ("no_degenerate", c.no_degenerate),
-        ("no_flips", c.no_flips),
     ] {
         assert_eq!(
             count, n,
             "certificate {name} held {count} times for {n} patches"
         );
     }
+    // Once per attempt (every attempt certifies its disk first).
+    assert_eq!(
+        c.disk,
+        remeshed + failures,
+        "disk certificate: {remeshed} remeshed patches + {failures} failed attempts"
+    );
+    // Once per attempt that got that far.
+    assert_eq!(c.bijective, remeshed + past_param, "bijective");
+    assert_eq!(c.planar, remeshed + past_planar, "planar");
+    assert_eq!(c.no_degenerate, remeshed, "no_degenerate");
+    assert_eq!(c.no_flips, remeshed, "no_flips");
     assert_eq!(c.no_self_intersections, 1);
     // Independent re-check of the final mesh with the foundation's certificates.
     let topo = Topology::build(&r.mesh);
     assert!(topo.is_oriented_manifold());
-    conemesh::invariants::certify_same_topology(&field.reference(), &r.mesh)
+    conemesh::invariants::certify_same_topology(field.reference(), &r.mesh)
         .expect("same topology as the input");
     conemesh::invariants::certify_boundary_preserved(field.reference(), &r.mesh)
         .expect("input boundary kept");
     assert!(conemesh::invariants::self_intersections(&r.mesh).is_empty());
     assert!(conemesh::quality::flips(field.reference(), &r.mesh).is_empty());
+    assert_eq!(r.report.faces_in, input.n_faces());
+    assert_eq!(r.report.faces_out, r.mesh.n_faces());
     // Every output vertex lies on the reference surface at its recorded location.
+    assert_eq!(r.locations.len(), r.mesh.n_vertices());
     for (p, loc) in r.mesh.positions.iter().zip(&r.locations) {
         let q = loc.position(field.reference());
         assert!((p - q).norm() <= 1e-12, "vertex off its reference location");
     }
-    let _ = input;
+}
+
+/// A strategy that delegates to the paper's [`ConePatches`] and records, before every
+/// patch, how many faces of the working mesh are still unprocessed.
+struct Recording {
+    inner: ConePatches,
+    unprocessed: Arc<Mutex<Vec<usize>>>,
+}
+
+impl PatchStrategy for Recording {
+    fn name(&self) -> &'static str {
+        "recording-cone"
+    }
+    fn next_patch(
+        &self,
+        ctx: &PatchContext<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Option<Patch>, PatchError> {
+        let left = ctx.processed.iter().filter(|p| !**p).count();
+        self.unprocessed.lock().expect("not poisoned").push(left);
+        self.inner.next_patch(ctx, rng)
+    }
+}
+
+fn assert_terminates(mesh: &TriMesh, seed: u64) {
+    let norm = Normalization::of(mesh);
+    let field =
+        MetricField::from_curvature(norm.apply(mesh), &MetricOptions::default()).expect("metric");
+    let unprocessed = Arc::new(Mutex::new(Vec::new()));
+    let stages = Stages {
+        patches: Box::new(Recording {
+            inner: ConePatches::default(),
+            unprocessed: unprocessed.clone(),
+        }),
+        ..Stages::default()
+    };
+    let options = RemeshOptions {
+        seed,
+        ..RemeshOptions::default()
+    };
+    let r = remesh(&field, &stages, &options, |_| {}).expect("remesh succeeds");
+    let seen = unprocessed.lock().expect("not poisoned").clone();
+    // The strategy is asked once per patch (never again once nothing is left).
+    assert_eq!(seen.len(), r.report.patches, "one request per patch");
+    assert_eq!(
+        seen[0],
+        mesh.n_faces(),
+        "all faces unprocessed at the start"
+    );
+    for (i, w) in seen.windows(2).enumerate() {
+        assert!(
+            w[1] < w[0],
+            "patch {} did not reduce the unprocessed count ({} -> {})",
+            i,
+            w[0],
+            w[1]
+        );
+    }
+    // Each patch consumes at least one input face, so the loop is bounded by the input size.
+    assert!(
+        r.report.patches <= mesh.n_faces(),
+        "{} patches for {} input faces",
+        r.report.patches,
+        mesh.n_faces()
+    );
+    for rec in &r.report.patch_records {
+        assert!(rec.unprocessed_in >= 1, "patch {} without progress", rec.id);
+    }
+    assert_certified(mesh, &field, &r);
+}
+
+#[test]
+fn the_loop_terminates_unprocessed_count_strictly_decreases() {
+    assert_terminates(&generators::torus(1.0, 0.35, 32, 12), 11);
+    assert_terminates(&generators::disk(1.0, 8, 24), 4);
 }
 
 #[test]

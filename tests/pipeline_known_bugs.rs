@@ -1,0 +1,96 @@
+//! Failing end-to-end tests for known problems of the pipeline / CLI (found by the e2e
+//! helper). Each is `#[ignore]`d with the reason; run them with
+//! `cargo test --release --test pipeline_known_bugs -- --ignored`. When a fix lands, remove
+//! the `ignore` and the test guards it.
+
+use conemesh::metric::{MetricField, MetricOptions, Normalization};
+use conemesh::pipeline::{remesh, RemeshOptions, Stages};
+use serde_json::Value;
+use std::path::Path;
+use std::process::Command;
+
+fn remesh_cli(dir: &Path, tag: &str, extra: &[&str]) -> Value {
+    let out = dir.join(format!("{tag}.obj"));
+    let report = dir.join(format!("{tag}.json"));
+    let o = Command::new(env!("CARGO_BIN_EXE_conemesh"))
+        .arg("remesh")
+        .arg("-o")
+        .arg(&out)
+        .arg("--report")
+        .arg(&report)
+        .arg("--quiet")
+        .args(extra)
+        .output()
+        .expect("run conemesh remesh");
+    assert!(
+        o.status.success(),
+        "conemesh remesh {extra:?} failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_slice(&std::fs::read(&report).expect("report")).expect("report JSON")
+}
+
+/// `conemesh remesh --ltar L`: the pipeline uses L as the unit-space metric length (metric
+/// lengths are invariant under the normalization: `metric_to_unit` divides M by scale²), so
+/// `--ltar <run.l_tar of a --ltar-factor 1.5 run>` reproduces that run byte for byte. But
+/// `quality::evaluate` converts `TargetLength::Absolute(l)` to `l * norm.scale`, so the
+/// printed/reported L/L_tar column of the same mesh is off by the scale (built-in torus:
+/// 3.43±0.55, 0.6 % in range, instead of 0.88±0.14, 90.4 %).
+#[test]
+#[ignore = "bug: quality::evaluate scales an absolute L_tar by norm.scale, the pipeline does not (src/quality/eval.rs, src/cli/remesh.rs)"]
+fn absolute_ltar_is_the_same_length_in_the_run_and_in_the_evaluation() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let by_factor = remesh_cli(dir.path(), "factor", &[]);
+    let l = by_factor["run"]["l_tar"].as_f64().expect("run.l_tar");
+    let absolute = remesh_cli(dir.path(), "absolute", &["--ltar", &format!("{l:e}")]);
+    // Whatever units `--ltar` is meant in, the remesher and the yardstick must use the same
+    // unit-space L_tar.
+    let run_l_tar = absolute["run"]["l_tar"].as_f64().expect("run.l_tar");
+    let eval_l_tar = absolute["eval"]["l_tar"].as_f64().expect("eval.l_tar");
+    assert!(
+        (eval_l_tar - run_l_tar).abs() <= 1e-12 * run_l_tar,
+        "the run remeshed to L_tar = {run_l_tar} but the evaluation measures against {eval_l_tar}"
+    );
+    if absolute["run"]["faces_out"] == by_factor["run"]["faces_out"] {
+        assert_eq!(
+            absolute["eval"]["output_conformity"], by_factor["eval"]["output_conformity"],
+            "same output, same L_tar: same L/L_tar statistics"
+        );
+    }
+}
+
+/// cow.off already has 118 self-intersecting face pairs (see `snapshots/check_cow_off.snap`).
+/// The final exact self-intersection certificate then fails the whole run
+/// (`final mesh: self-intersecting face pairs: f0×f2911, …, and 69 more`, 79 pairs), after
+/// all the work, and `conemesh remesh cow.off` writes no output (exit 2). Issue 9 asks that
+/// `conemesh remesh` succeed on every shared mesh; the certificate should be relative to the
+/// input (no self-intersection the input does not have), or the run should refuse such an
+/// input up front with a clear message.
+#[test]
+#[ignore = "gap: the final no-self-intersection certificate rejects inputs that already self-intersect (cow.off)"]
+fn cow_with_a_self_intersecting_input_is_remeshed() {
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/meshes/cow.off"
+    ));
+    let mesh = conemesh::io::read_mesh(path)
+        .expect("cow.off")
+        .mesh
+        .without_unreferenced_vertices()
+        .0;
+    assert!(
+        !conemesh::invariants::self_intersections(&mesh).is_empty(),
+        "the premise: cow.off self-intersects"
+    );
+    let norm = Normalization::of(&mesh);
+    let field =
+        MetricField::from_curvature(norm.apply(&mesh), &MetricOptions::default()).expect("metric");
+    let r = remesh(
+        &field,
+        &Stages::default(),
+        &RemeshOptions::default(),
+        |_| {},
+    );
+    let r = r.unwrap_or_else(|e| panic!("cow.off: {e}"));
+    conemesh::invariants::certify_same_topology(field.reference(), &r.mesh).expect("topology");
+}
