@@ -3,6 +3,7 @@
 //! certificate; snapshot of the per-mesh counts and rounded distortion. The full table over
 //! all shared meshes is `cargo run --release --example param_cover`.
 
+#[path = "common/param_cover.rs"]
 mod common;
 
 use common::run_mesh;
@@ -16,7 +17,12 @@ fn r2(x: f64) -> f64 {
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn every_cover_patch_of_four_shared_meshes_is_certified() {
     let mut snap = BTreeMap::new();
-    for name in ["fertility.off", "3holes.off", "screwdriver.off", "bunny.off"] {
+    for name in [
+        "fertility.off",
+        "3holes.off",
+        "screwdriver.off",
+        "bunny.off",
+    ] {
         let (run, _, _) = run_mesh(name).unwrap_or_else(|e| panic!("{e}"));
         let failed: Vec<String> = run
             .patches

@@ -78,7 +78,11 @@ impl MeshRun {
         Summary {
             patches: self.patches.len(),
             certified: ok.len(),
-            mean_conformal_area_weighted: if area > 0.0 { weighted / area } else { f64::NAN },
+            mean_conformal_area_weighted: if area > 0.0 {
+                weighted / area
+            } else {
+                f64::NAN
+            },
             worst_max_conformal: ok.iter().map(|(_, r)| r.max_conformal).fold(0.0, f64::max),
             fallbacks: ok.iter().filter(|(_, r)| r.fell_back).count(),
             budget_hits: ok.iter().filter(|(_, r)| r.hit_budget).count(),
