@@ -24,10 +24,10 @@ use crate::mesh::{SurfaceLocation, Topology, TriMesh};
 use crate::metric::MetricField;
 use crate::param::{DistortionReport, Parameterizer, SymmetricDirichlet};
 use crate::patches::{extract_patch, ConePatches, DiskPatch, PatchContext, PatchStrategy};
+use crate::quality::FlipTest;
 use crate::remesh2d::{
     transfer_metric, Lct, PlanarDomain, PlanarMetricField, PlanarRemesher, TransferMethod,
 };
-use crate::quality::FlipTest;
 use crate::stitch::{stitch, Replacement, WorkingMesh};
 use nalgebra::Matrix3;
 use rand::SeedableRng;
@@ -192,6 +192,9 @@ pub struct Certificate {
     pub no_degenerate: usize,
     /// No new face flipped against the reference after the patch.
     pub no_flips: usize,
+    /// Candidates certified free of local self-intersections (exact; only for an embedded
+    /// input).
+    pub locally_embedded: usize,
     /// Final mesh free of self-intersections (exact), 0 if not checked.
     pub no_self_intersections: usize,
     /// Self-intersecting face pairs of the output; non-zero only when the input itself
@@ -316,6 +319,14 @@ pub fn remesh(
     }
     let mut rng = crate::Rng::seed_from_u64(options.seed);
     let flip_test = FlipTest::new(reference);
+    // Candidates are checked for local self-intersections only when the input is embedded
+    // (an input that self-intersects cannot be replaced by an embedded surface on it).
+    let input_pairs = if options.check_self_intersections {
+        invariants::self_intersections(reference).len()
+    } else {
+        0
+    };
+    let embedded_input = options.check_self_intersections && input_pairs == 0;
     let mut work = WorkingMesh::from_reference(reference);
     let ref_topo = Topology::build(reference);
     let signature = topology_signature(&ref_topo);
@@ -392,7 +403,17 @@ pub fn remesh(
             cert.disk += 1;
             times.patches += t0.elapsed().as_secs_f64();
             let attempt = remesh_patch(
-                field, stages, options, &work, &flip_test, &faces, l_tar, &mut rng, &mut times, &mut cert,
+                field,
+                stages,
+                options,
+                &work,
+                &flip_test,
+                embedded_input,
+                &faces,
+                l_tar,
+                &mut rng,
+                &mut times,
+                &mut cert,
             );
             match attempt {
                 Ok((replacement, distortion)) => {
@@ -506,7 +527,6 @@ pub fn remesh(
             // An input that itself self-intersects (cow.off does, at 118 face pairs) cannot
             // give an embedded output that lies on it; that is reported, not an error. An
             // embedded input must give an embedded output.
-            let input_pairs = invariants::self_intersections(reference).len();
             if input_pairs == 0 {
                 return Err(PipelineError::Final(InvariantError::SelfIntersections(
                     Offenders(
@@ -633,6 +653,7 @@ fn remesh_patch(
     options: &RemeshOptions,
     work: &WorkingMesh,
     flip_test: &FlipTest,
+    embedded_input: bool,
     faces: &[FaceId],
     l_tar: f64,
     rng: &mut crate::Rng,
@@ -723,6 +744,17 @@ fn remesh_patch(
     }
     cert.no_degenerate += 1;
     cert.no_flips += 1;
+    if embedded_input {
+        let t0 = Instant::now();
+        let checked = certify_candidate_embedded(work, faces, &replacement);
+        times.certify += t0.elapsed().as_secs_f64();
+        if let Err(e) = checked {
+            let mut f = Failure::certificate("lifted faces", e);
+            f.candidate = Some(replacement);
+            return Err(f);
+        }
+        cert.locally_embedded += 1;
+    }
     Ok((replacement, param.report))
 }
 
@@ -795,7 +827,7 @@ fn certify_replacement(
             degenerate.push(f);
             continue;
         }
-        if flip_test.is_flipped(&p) {
+        if flip_test.is_flipped_anywhere(&p) {
             flipped.push(f);
         }
     }
@@ -806,6 +838,69 @@ fn certify_replacement(
         return Err(InvariantError::FlippedFaces(Offenders(flipped)));
     }
     Ok(())
+}
+
+/// Exact local self-intersection test of a candidate: the new faces against each other and
+/// against the working-mesh faces (outside the patch) whose bounding boxes meet the new faces'
+/// bounding box. Pairs of two old faces are not the candidate's doing and are ignored. Face ids
+/// in the error: `f0..` are the candidate's triangles, larger ids the old faces in the order
+/// they were gathered.
+fn certify_candidate_embedded(
+    work: &WorkingMesh,
+    patch_faces: &[FaceId],
+    r: &Replacement,
+) -> Result<(), InvariantError> {
+    use crate::stitch::PatchVertex;
+    let mut positions = work.mesh.positions.clone();
+    let base = positions.len() as u32;
+    positions.extend_from_slice(&r.new_positions);
+    let new_tris: Vec<[VertexId; 3]> = r
+        .triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| match v {
+                PatchVertex::Existing(g) => g,
+                PatchVertex::New(i) => VertexId(base + i),
+            })
+        })
+        .collect();
+    let Some((lo, hi)) = bbox_of(new_tris.iter().flatten().map(|v| positions[v.idx()])) else {
+        return Ok(());
+    };
+    let in_patch: HashSet<FaceId> = patch_faces.iter().copied().collect();
+    let n_new = new_tris.len();
+    let mut tris = new_tris;
+    for (f, t) in work.mesh.triangles.iter().enumerate() {
+        if in_patch.contains(&FaceId::new(f)) {
+            continue;
+        }
+        if let Some((a, b)) = bbox_of(t.iter().map(|v| positions[v.idx()])) {
+            if (0..3).all(|k| a[k] <= hi[k] && b[k] >= lo[k]) {
+                tris.push(*t);
+            }
+        }
+    }
+    let local = TriMesh {
+        positions,
+        triangles: tris,
+    };
+    let pairs: Vec<invariants::FacePair> = invariants::self_intersections(&local)
+        .into_iter()
+        .filter(|(a, b)| a.idx() < n_new || b.idx() < n_new)
+        .map(|(a, b)| invariants::FacePair(a, b))
+        .collect();
+    if pairs.is_empty() {
+        Ok(())
+    } else {
+        Err(InvariantError::SelfIntersections(Offenders(pairs)))
+    }
+}
+
+fn bbox_of(
+    mut pts: impl Iterator<Item = nalgebra::Point3<f64>>,
+) -> Option<(nalgebra::Point3<f64>, nalgebra::Point3<f64>)> {
+    let first = pts.next()?;
+    Some(pts.fold((first, first), |(lo, hi), p| (lo.inf(&p), hi.sup(&p))))
 }
 
 /// Exact: the three points are collinear iff all three coordinate projections are.

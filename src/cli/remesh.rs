@@ -114,7 +114,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     };
     let options = RemeshOptions {
         seed: args.seed,
-        // A metric length scales with the mesh: lengths in file units × scale (Normalization).
+        // A metric length is the same in file units and in unit space (Normalization).
         target: match args.ltar {
             Some(l) => TargetLength::Absolute(l),
             None => TargetLength::Factor(args.ltar_factor),

@@ -170,15 +170,16 @@ pub fn approximation_error(
     }
 }
 
-/// The flip test of the quality issue, shared by `eval` and the pipeline's per-patch
-/// certificate so that both give the same verdict: a face is flipped when its normal points
-/// more than 90° away from the normal of the input face closest to its centroid.
+/// The flip test of the quality issue: a face is flipped when its normal points more than 90°
+/// away from the normal of the input face closest to its centroid.
 ///
-/// Ties: where the centroid's closest point lies on an input edge or vertex (a sharp crease:
-/// several input faces at the same distance), the closest face is not unique and "the" input
-/// normal is undefined; a face is then flipped only if it points away from every input face at
-/// that distance (faces around the closest face within a relative 1e-9 of the smallest
-/// distance, a measurement tolerance on distances, not an orientation decision).
+/// Two verdicts: [`FlipTest::is_flipped`] uses the one closest face the BVH returns (the
+/// yardstick's definition, as the peers' evaluator); [`FlipTest::is_flipped_anywhere`] is the
+/// conservative verdict used by the pipeline's per-patch certificate: where the centroid's
+/// closest point lies on an input edge or vertex (a sharp crease, several input faces at the
+/// same distance, within a relative 1e-9 — a measurement tolerance on distances), the face is
+/// flipped if it points away from ANY of them. So a certified output has no flip under any
+/// tie-break.
 ///
 /// The decision is the sign of the float dot product of the two (unnormalised) face normals,
 /// strictly negative = flipped: a float decision on normals, not an exact predicate. Zero-area
@@ -205,17 +206,28 @@ impl FlipTest {
         }
     }
 
-    /// Is the triangle `p` (counter-clockwise seen from outside) flipped against the input?
+    /// Flipped against the closest input face (ties broken by the BVH).
     pub fn is_flipped(&self, p: &[Point3<f64>; 3]) -> bool {
+        let n_out: Vector3<f64> = (p[1] - p[0]).cross(&(p[2] - p[0]));
+        let c = Point3::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
+        match self.proj.closest(&c) {
+            Some((fin, _, _)) => n_out.dot(&self.input.face_normal_raw(fin)) < 0.0,
+            None => false,
+        }
+    }
+
+    /// Flipped against any of the input faces closest to the centroid (conservative).
+    pub fn is_flipped_anywhere(&self, p: &[Point3<f64>; 3]) -> bool {
         let n_out: Vector3<f64> = (p[1] - p[0]).cross(&(p[2] - p[0]));
         let c = Point3::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
         let Some((fin, _, d)) = self.proj.closest(&c) else {
             return false;
         };
-        if n_out.dot(&self.input.face_normal_raw(fin)) >= 0.0 {
-            return false;
+        if n_out.dot(&self.input.face_normal_raw(fin)) < 0.0 {
+            return true;
         }
-        // The closest face disagrees: look for an equally close input face that agrees.
+        // Equally close faces share a vertex with the closest one (closest point on an edge or
+        // vertex of it).
         let tol = d * 1e-9 + f64::MIN_POSITIVE;
         for v in self.input.face(fin) {
             for &g in &self.vertex_faces[v.idx()] {
@@ -230,12 +242,12 @@ impl FlipTest {
                 );
                 use parry3d_f64::query::PointQuery;
                 let dg = tri.distance_to_local_point(PVec::new(c.x, c.y, c.z), false);
-                if dg <= d + tol && n_out.dot(&self.input.face_normal_raw(g)) >= 0.0 {
-                    return false;
+                if dg <= d + tol && n_out.dot(&self.input.face_normal_raw(g)) < 0.0 {
+                    return true;
                 }
             }
         }
-        true
+        false
     }
 }
 

@@ -172,9 +172,9 @@ pub fn evaluate(
     let l_avg = edge_length_average(&unit_in, in_metrics);
     let l_tar = match opts.target {
         TargetLength::Factor(f) => f * l_avg,
-        // A metric length in file units times the unit scale is the same length in unit
-        // space (metric_to_unit divides M by scale²).
-        TargetLength::Absolute(l) => l * norm.scale,
+        // A metric length does not depend on the scale: a vector scales by `scale` and the
+        // metric by 1/scale² (`metric_to_unit`), so √(eᵀMe) is unchanged.
+        TargetLength::Absolute(l) => l,
     };
     let input_quality = quality_stats(&unit_in, in_metrics);
     let output_quality = quality_stats(&unit_out, &out_metrics);

@@ -1,7 +1,6 @@
-//! Failing end-to-end tests for known problems of the pipeline / CLI (found by the e2e
-//! helper). Each is `#[ignore]`d with the reason; run them with
-//! `cargo test --release --test pipeline_known_bugs -- --ignored`. When a fix lands, remove
-//! the `ignore` and the test guards it.
+//! Regression tests for problems the end-to-end tests found (both fixed): an absolute
+//! `--ltar` measured in different units by the run and by `eval`, and an input that already
+//! self-intersects (cow.off) failing the final certificate.
 
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
 use conemesh::pipeline::{remesh, RemeshOptions, Stages};
@@ -37,7 +36,6 @@ fn remesh_cli(dir: &Path, tag: &str, extra: &[&str]) -> Value {
 /// printed/reported L/L_tar column of the same mesh is off by the scale (built-in torus:
 /// 3.43±0.55, 0.6 % in range, instead of 0.88±0.14, 90.4 %).
 #[test]
-#[ignore = "bug: quality::evaluate scales an absolute L_tar by norm.scale, the pipeline does not (src/quality/eval.rs, src/cli/remesh.rs)"]
 fn absolute_ltar_is_the_same_length_in_the_run_and_in_the_evaluation() {
     let dir = tempfile::tempdir().expect("tempdir");
     let by_factor = remesh_cli(dir.path(), "factor", &[]);
@@ -67,7 +65,6 @@ fn absolute_ltar_is_the_same_length_in_the_run_and_in_the_evaluation() {
 /// input (no self-intersection the input does not have), or the run should refuse such an
 /// input up front with a clear message.
 #[test]
-#[ignore = "gap: the final no-self-intersection certificate rejects inputs that already self-intersect (cow.off)"]
 fn cow_with_a_self_intersecting_input_is_remeshed() {
     let path = Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -93,4 +90,14 @@ fn cow_with_a_self_intersecting_input_is_remeshed() {
     );
     let r = r.unwrap_or_else(|e| panic!("cow.off: {e}"));
     conemesh::invariants::certify_same_topology(field.reference(), &r.mesh).expect("topology");
+    // The output's self-intersections are reported against the input's, not hidden.
+    let c = &r.report.certificate;
+    let pairs = conemesh::invariants::self_intersections(&r.mesh).len();
+    if pairs == 0 {
+        assert_eq!(c.no_self_intersections, 1);
+    } else {
+        assert_eq!(c.no_self_intersections, 0);
+        assert_eq!(c.self_intersecting_pairs, pairs);
+        assert_eq!(c.input_self_intersecting_pairs, Some(118));
+    }
 }
