@@ -170,8 +170,12 @@ pub struct StageTimes {
     pub final_check: f64,
 }
 
-/// How many times each certificate was checked and held. A run that returns `Ok` has every
-/// count equal to the number of patches (or 1 for the final ones).
+/// How many times each certificate was checked and held (a failed check is either an error
+/// or, for a patch attempt, a recorded failure followed by a retry). Per accepted patch:
+/// `manifold`, `oriented`, `same_topology`, `boundary_preserved` once each (also for kept
+/// patches); per attempt that reached the stage: `disk`, `bijective`, `planar`; per remeshed
+/// (not kept) patch: `no_degenerate`, `no_flips` and, for an embedded input,
+/// `locally_embedded`.
 #[derive(Clone, Debug, Default, Serialize, PartialEq, Eq)]
 pub struct Certificate {
     /// Patches certified to be topological disks.
@@ -274,7 +278,7 @@ pub struct RemeshReport {
 pub struct Progress {
     /// Patches done.
     pub patches: usize,
-    /// Input faces covered so far (processed fraction of the working mesh).
+    /// Faces of the working mesh still unprocessed (strictly decreasing).
     pub unprocessed: usize,
     /// Faces at the start.
     pub total: usize,
