@@ -15,6 +15,9 @@ pub enum Error {
     /// A certified invariant does not hold.
     #[error(transparent)]
     Invariant(#[from] crate::invariants::InvariantError),
+    /// Reading or writing a Medit `.sol` metric.
+    #[error(transparent)]
+    Sol(#[from] crate::io::sol::SolError),
     /// Metric field (Sec. 3.1).
     #[error(transparent)]
     Metric(#[from] crate::metric::MetricError),
@@ -27,6 +30,12 @@ pub enum Error {
     /// Planar remeshing (Sec. 3.3).
     #[error(transparent)]
     Remesh2d(#[from] crate::remesh2d::Remesh2dError),
+    /// Mapping a remeshed patch back to the surface (Sec. 3.3).
+    #[error(transparent)]
+    Lift(#[from] crate::lift::LiftError),
+    /// Replacing a patch in the working mesh.
+    #[error(transparent)]
+    Stitch(#[from] crate::stitch::StitchError),
     /// Algorithm 1.
     #[error(transparent)]
     Pipeline(#[from] crate::pipeline::PipelineError),

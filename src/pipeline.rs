@@ -77,6 +77,16 @@ pub enum PipelineError {
         /// its seed
         seed: VertexId,
     },
+    /// The strategy returned no patch while faces were still unprocessed.
+    #[error(
+        "patch strategy `{strategy}` returned no patch with {unprocessed} faces still unprocessed"
+    )]
+    StrategyStopped {
+        /// the strategy's name
+        strategy: &'static str,
+        /// faces left
+        unprocessed: usize,
+    },
     /// The patch budget ran out.
     #[error("stopped after {0} patches (--max-patches) with {1} faces unprocessed")]
     Budget(usize, usize),
@@ -333,6 +343,13 @@ pub fn remesh(
     let embedded_input = options.check_self_intersections && input_pairs == 0;
     let mut work = WorkingMesh::from_reference(reference);
     let ref_topo = Topology::build(reference);
+    // The input must be an oriented 2-manifold (with boundary): say so up front, naming the
+    // elements, rather than failing later inside a patch.
+    invariants::certify_manifold(reference, &ref_topo)
+        .and_then(|()| invariants::certify_oriented(reference, &ref_topo))
+        .map_err(|e| {
+            PipelineError::Input(format!("the input mesh is not an oriented manifold: {e}"))
+        })?;
     let signature = topology_signature(&ref_topo);
     // The input's boundary edges, by vertex ids (input vertices are never renumbered during
     // the loop and boundary vertices are never moved: the remesher keeps patch boundaries).
@@ -369,7 +386,12 @@ pub fn remesh(
         };
         let patch = match stages.patches.next_patch(&ctx, &mut rng) {
             Ok(Some(p)) => p,
-            Ok(None) => break,
+            Ok(None) => {
+                return Err(PipelineError::StrategyStopped {
+                    strategy: stages.patches.name(),
+                    unprocessed: work.unprocessed(),
+                })
+            }
             Err(e) => {
                 return Err(PipelineError::Stage {
                     patch: pid,
@@ -411,6 +433,7 @@ pub fn remesh(
                 stages,
                 options,
                 &work,
+                &topo,
                 &flip_test,
                 embedded_input,
                 &faces,
@@ -656,6 +679,7 @@ fn remesh_patch(
     stages: &Stages,
     options: &RemeshOptions,
     work: &WorkingMesh,
+    topo: &Topology,
     flip_test: &FlipTest,
     embedded_input: bool,
     faces: &[FaceId],
@@ -739,7 +763,7 @@ fn remesh_patch(
 
     // (f) certify the candidate's new faces before touching the working mesh.
     let t0 = Instant::now();
-    let checked = certify_replacement(flip_test, work, &replacement);
+    let checked = certify_replacement(flip_test, work, topo, faces, &replacement);
     times.certify += t0.elapsed().as_secs_f64();
     if let Err(e) = checked {
         let mut f = Failure::certificate("lifted faces", e);
@@ -813,9 +837,35 @@ fn shrink_patch(
 fn certify_replacement(
     flip_test: &FlipTest,
     work: &WorkingMesh,
+    topo: &Topology,
+    patch_faces: &[FaceId],
     r: &Replacement,
 ) -> Result<(), InvariantError> {
     use crate::stitch::PatchVertex;
+    // A new edge between two existing (patch boundary) vertices must not already be an edge
+    // of the working mesh outside the patch: a disk patch can touch itself from outside (two
+    // boundary vertices joined by an outside edge), and a planar chord between them would
+    // give that edge four faces after stitching.
+    let in_patch: HashSet<FaceId> = patch_faces.iter().copied().collect();
+    let mut duplicated = Vec::new();
+    for t in &r.triangles {
+        for k in 0..3 {
+            if let (PatchVertex::Existing(a), PatchVertex::Existing(b)) = (t[k], t[(k + 1) % 3]) {
+                let outside = topo
+                    .vertex_faces(a)
+                    .iter()
+                    .any(|f| !in_patch.contains(f) && work.mesh.triangles[f.idx()].contains(&b));
+                if outside {
+                    duplicated.push(invariants::EdgeFaces(EdgeKey::new(a, b), 4));
+                }
+            }
+        }
+    }
+    if !duplicated.is_empty() {
+        duplicated.sort_by_key(|e| e.0);
+        duplicated.dedup();
+        return Err(InvariantError::NonManifoldEdges(Offenders(duplicated)));
+    }
     let pos = |v: &PatchVertex| match *v {
         PatchVertex::Existing(g) => work.mesh.positions[g.idx()],
         PatchVertex::New(i) => r.new_positions[i as usize],

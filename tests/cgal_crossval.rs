@@ -763,50 +763,5 @@ fn cgal_hausdorff_matches_the_analytic_distance_of_offset_spheres() {
     assert!(ba <= 0.1 + 1.0 * (1.0 - (max_edge / 2.2).cos()) + 1e-12 + bound);
 }
 
-// =======================================================================================
-// HAUSDORFF CROSS-CHECK WITH conemesh — DISABLED until `crate::quality::approximation_error`
-// is on main. It exists on branch `quality` (src/quality/distance.rs:
-// `approximation_error(a, b, min_samples, &mut Rng) -> Distance { hausdorff_a_to_b,
-// hausdorff_b_to_a, .. }`), which this branch may not merge. To enable: uncomment.
-//
-// Both sides under-estimate the true one-sided distances (they take maxima over samples, with
-// exact point–triangle distances). CGAL's grid sampling misses the true value by at most its
-// spacing H (`error_bound`); conemesh samples all vertices plus `n` area-weighted random
-// points, so its miss is bounded by about the sample spacing sqrt(area / n) times the
-// 1-Lipschitz constant, i.e. δ = 3·sqrt(area / n) with overwhelming probability. Hence:
-// conemesh ≤ CGAL + H (nobody exceeds the truth) and conemesh ≥ CGAL − δ.
-//
-// #[test]
-// fn hausdorff_agrees_with_cgal() {
-//     use conemesh::quality::approximation_error;
-//     let a = generators::icosphere(1.0, 3);
-//     let mut b = generators::icosphere(1.0, 1);
-//     for p in &mut b.positions {
-//         *p = Point3::from(p.coords * 1.05);
-//     }
-//     let dir = tempfile::tempdir().expect("tempdir");
-//     let (pa, pb) = (dir.path().join("a.off"), dir.path().join("b.off"));
-//     write_off(&pa, &a);
-//     write_off(&pb, &b);
-//     let cgal = run_checker(&pa, &["--hausdorff", pb.to_str().expect("utf-8 path")]);
-//     let h = &cgal["hausdorff"];
-//     let (ab, ba, bound) = (
-//         h["mesh_to_other"].as_f64().expect("number"),
-//         h["other_to_mesh"].as_f64().expect("number"),
-//         h["error_bound"].as_f64().expect("number"),
-//     );
-//     let n = 20_000;
-//     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-//     let d = approximation_error(&a, &b, n, &mut rng);
-//     let delta = |m: &TriMesh| 3.0 * (m.area() / n as f64).sqrt();
-//     for (ours, theirs, dl, what) in [
-//         (d.hausdorff_a_to_b, ab, delta(&a), "a→b"),
-//         (d.hausdorff_b_to_a, ba, delta(&b), "b→a"),
-//     ] {
-//         assert!(
-//             ours <= theirs + bound + 1e-12 && ours >= theirs - dl,
-//             "{what}: conemesh {ours} vs CGAL {theirs} (H {bound}, δ {dl})"
-//         );
-//     }
-// }
-// =======================================================================================
+// The Hausdorff cross-check against conemesh's own measure lives in tests/cgal_pipeline.rs
+// (outputs of `conemesh remesh` against their inputs).

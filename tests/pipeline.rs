@@ -66,6 +66,20 @@ fn assert_certified(input: &TriMesh, field: &MetricField, r: &RemeshResult) {
     let n = r.report.patches;
     assert!(n > 0);
     assert_eq!(r.report.patch_records.len(), n);
+    // Really remeshed: most input faces replaced (an output equal to the input, every patch
+    // kept, would pass the certificates below).
+    assert!(
+        r.report.fallbacks.kept_faces * 20 <= input.n_faces(),
+        "{} of {} input faces kept unchanged",
+        r.report.fallbacks.kept_faces,
+        input.n_faces()
+    );
+    assert!(r.report.patch_records.iter().filter(|p| !p.kept).count() * 2 > n);
+    assert_ne!(
+        r.mesh.n_faces(),
+        input.n_faces(),
+        "face count unchanged: not remeshed?"
+    );
     // Patches whose every attempt failed keep their faces unchanged (the retry ladder's last
     // rung): they pass the working-mesh certificates but not the per-candidate ones.
     let kept = r.report.patch_records.iter().filter(|p| p.kept).count();

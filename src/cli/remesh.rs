@@ -80,17 +80,28 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         .and_then(|p| p.file_stem())
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "torus".into());
-    // Unreferenced vertices carry no surface; drop them (their ids are not kept).
-    let (file_mesh, _) = file_mesh.without_unreferenced_vertices();
-    let norm = Normalization::of(&file_mesh);
-    let reference = norm.apply(&file_mesh);
-    let user_metric = match &args.metric {
+    // A user metric has one tensor per vertex of the file, in file order.
+    let file_metric = match &args.metric {
         Some(p) => Some(
             conemesh::io::sol::read_sol(p, file_mesh.n_vertices())
                 .with_context(|| format!("reading metric {}", p.display()))?,
         ),
         None => None,
     };
+    // Unreferenced vertices carry no surface; drop them. The compaction keeps the order of the
+    // other vertices, and the user metric follows them through the map.
+    let (file_mesh, map) = file_mesh.without_unreferenced_vertices();
+    let user_metric = file_metric.map(|m| {
+        let mut kept = vec![nalgebra::Matrix3::zeros(); file_mesh.n_vertices()];
+        for (old, new) in map.iter().enumerate() {
+            if let Some(n) = new {
+                kept[n.idx()] = m[old];
+            }
+        }
+        kept
+    });
+    let norm = Normalization::of(&file_mesh);
+    let reference = norm.apply(&file_mesh);
     let field = match &user_metric {
         Some(m) => MetricField::new(
             reference,
@@ -158,16 +169,14 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         &file_mesh,
         &norm,
     );
-    conemesh::io::write_mesh(&args.output, &out_file)
-        .with_context(|| format!("writing {}", args.output.display()))?;
-    let out_metrics: Vec<_> = result.locations.iter().map(|l| field.eval_at(l)).collect();
-    if let Some(p) = &args.write_metric {
-        let m: Vec<_> = out_metrics
-            .iter()
-            .map(|m| norm.metric_from_unit(m))
-            .collect();
-        conemesh::io::sol::write_sol(p, &m, false)
-            .with_context(|| format!("writing {}", p.display()))?;
+    // The certificates were taken in unit space; mapping back to file units rounds the new
+    // vertices, so the mesh that is written is certified again (exact): no degenerate face,
+    // and no self-intersection where the unit-space output had none.
+    conemesh::invariants::certify_no_degenerate_faces(&out_file)
+        .context("the output in file units (after mapping back from unit space)")?;
+    if result.report.certificate.no_self_intersections == 1 {
+        conemesh::invariants::certify_no_self_intersections(&out_file)
+            .context("the output in file units (after mapping back from unit space)")?;
     }
     let elapsed = t_start.elapsed().as_secs_f64();
     // The yardstick, independent of the remesher: `conemesh eval` on the written output.
@@ -200,7 +209,27 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             _ => "not checked".to_string(),
         }
     );
+    let fb = &result.report.fallbacks;
+    if fb.kept_faces > 0 || fb.shrinks > 0 {
+        eprintln!(
+            "warning: {} patch attempt(s) failed their certificates and were retried smaller; {} input face(s) could not be remeshed and were kept unchanged (details: --report, `fallbacks`)",
+            fb.failures.len(),
+            fb.kept_faces
+        );
+    }
+    // Everything is computed; write the outputs (each atomically), the mesh first.
+    conemesh::io::write_mesh(&args.output, &out_file)
+        .with_context(|| format!("writing {}", args.output.display()))?;
     println!("wrote {}", args.output.display());
+    if let Some(p) = &args.write_metric {
+        let m: Vec<_> = result
+            .locations
+            .iter()
+            .map(|l| norm.metric_from_unit(&field.eval_at(l)))
+            .collect();
+        conemesh::io::sol::write_sol(p, &m, false)
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
     if let Some(p) = &args.report {
         let json = serde_json::json!({
             "input": name,

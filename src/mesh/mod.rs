@@ -311,22 +311,30 @@ impl TriMesh {
         }
     }
 
-    /// A copy without vertices that no triangle references, and the map old → new id.
+    /// A copy without vertices that no triangle references, and the map old → new id. The
+    /// kept vertices keep their relative order (so per-vertex data given in file order, such
+    /// as a `.sol` metric, follows them through the map; a mesh without unreferenced
+    /// vertices comes back unchanged).
     pub fn without_unreferenced_vertices(&self) -> (TriMesh, Vec<Option<VertexId>>) {
+        let mut used = vec![false; self.n_vertices()];
+        for t in &self.triangles {
+            for v in t {
+                used[v.idx()] = true;
+            }
+        }
         let mut map = vec![None; self.n_vertices()];
         let mut positions = Vec::new();
-        let mut triangles = Vec::with_capacity(self.n_faces());
-        for t in &self.triangles {
-            let mut nt = [VertexId(0); 3];
-            for (k, v) in t.iter().enumerate() {
-                let id = *map[v.idx()].get_or_insert_with(|| {
-                    positions.push(self.positions[v.idx()]);
-                    VertexId::new(positions.len() - 1)
-                });
-                nt[k] = id;
+        for (old, u) in used.iter().enumerate() {
+            if *u {
+                map[old] = Some(VertexId::new(positions.len()));
+                positions.push(self.positions[old]);
             }
-            triangles.push(nt);
         }
+        let triangles: Vec<[VertexId; 3]> = self
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| map[v.idx()].unwrap_or(VertexId(0))))
+            .collect();
         (
             TriMesh {
                 positions,

@@ -489,9 +489,9 @@ pub fn optimize_with_log(
     let pat = Pattern::new(n, &disk.triangles);
     let dim = 2 * n;
     let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
-    // One symbolic factorisation (AMD ordering) for all iterations. Sequential: patches are
-    // parameterized in parallel by the caller, and small factorisations gain nothing from
-    // threads on a loaded machine.
+    // One symbolic factorisation (AMD ordering) for all iterations. Sequential (`Par::Seq`):
+    // the result must not depend on the thread count (same seed → same bytes), and small
+    // factorisations gain little from threads.
     let symbolic =
         factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
             .map_err(|e| ParamError::Solver(format!("symbolic Cholesky: {e:?}")))?;

@@ -202,6 +202,9 @@ pub fn tutte_embedding(
     }
     let a = SparseColMat::<usize, f64>::try_new_from_triplets(n_free, n_free, &trips)
         .map_err(|e| ParamError::Solver(format!("assembling the Tutte Laplacian: {e:?}")))?;
+    // faer's high-level solvers use its global parallelism, which is sequential because faer
+    // is built without its `rayon` feature (Cargo.toml): the map, and so the output bytes, do
+    // not depend on the thread count. Enabling that feature would need `Par::Seq` here.
     let sol = if weights_kind == TutteWeights::MeanValue {
         a.sp_lu()
             .map_err(|e| ParamError::Solver(format!("Tutte LU: {e:?}")))?

@@ -354,12 +354,12 @@ impl Grown<'_, '_> {
             distance.insert(top.face, d_t);
             let mut stack = vec![top.face];
             while let Some(f) = stack.pop() {
-                let df = distance[&f];
+                let df = distance.get(&f).copied().unwrap_or(f64::INFINITY);
                 let cf = centroid(f);
                 let nbrs: Vec<FaceId> = patch.patch_neighbors(f).map(|(_, g)| g).collect();
                 for g in nbrs {
                     let cand = df + (centroid(g) - cf).norm();
-                    if cand < distance[&g] {
+                    if cand < distance.get(&g).copied().unwrap_or(f64::INFINITY) {
                         distance.insert(g, cand);
                         stack.push(g);
                     }
