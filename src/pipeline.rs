@@ -851,11 +851,18 @@ fn certify_replacement(
     for t in &r.triangles {
         for k in 0..3 {
             if let (PatchVertex::Existing(a), PatchVertex::Existing(b)) = (t[k], t[(k + 1) % 3]) {
-                let outside = topo
-                    .vertex_faces(a)
+                let has_edge = |f: &&FaceId| work.mesh.triangles[f.idx()].contains(&b);
+                let faces_a = topo.vertex_faces(a);
+                // An edge of the patch itself (its boundary edges) is fine.
+                let patch_edge = faces_a
                     .iter()
-                    .any(|f| !in_patch.contains(f) && work.mesh.triangles[f.idx()].contains(&b));
-                if outside {
+                    .filter(has_edge)
+                    .any(|f| in_patch.contains(f));
+                let outside = faces_a
+                    .iter()
+                    .filter(has_edge)
+                    .any(|f| !in_patch.contains(f));
+                if outside && !patch_edge {
                     duplicated.push(invariants::EdgeFaces(EdgeKey::new(a, b), 4));
                 }
             }
