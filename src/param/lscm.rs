@@ -124,3 +124,25 @@ pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, P
     }
     Ok(uv)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::invariants::certify_bijective;
+    use crate::mesh::generators;
+    use crate::param::{disk_boundary, distortion, scale_to_area};
+
+    #[test]
+    fn lscm_of_a_developable_piece_is_an_isometry_after_scaling() {
+        // A cone piece unrolls isometrically, and LSCM is exact on similarities: after the
+        // area rescale every triangle must be (numerically) isometric and the map certified.
+        let m = generators::cone_piece(0.6, 2.5, 0.4, 2.0, 20, 10);
+        let b = disk_boundary(&m).unwrap();
+        let mut uv = lscm(&m, &b).unwrap();
+        scale_to_area(&m, &mut uv);
+        certify_bijective(&uv, &m.triangles, &b).unwrap();
+        let r = distortion(&m, &uv);
+        assert!(r.max_conformal < 1.0 + 1e-6, "{r:?}");
+        assert!(r.max_area_distortion < 1e-6, "{r:?}");
+    }
+}
