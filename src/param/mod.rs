@@ -2,10 +2,12 @@
 //! [`Parameterizer`] extension point.
 
 mod distortion;
+mod lscm;
 mod sdirichlet;
 mod tutte;
 
 pub use distortion::{distortion, triangle_frames, TriangleFrame};
+pub use lscm::lscm;
 pub use sdirichlet::{optimize_with_log, SdLog, SdOptions, SymmetricDirichlet};
 pub use tutte::{circle_boundary, scale_to_area, tutte_embedding, Tutte, TutteWeights};
 

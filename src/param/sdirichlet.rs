@@ -6,7 +6,8 @@
 //!   for a 2×2 Jacobian is `‖F‖² (1 + det(F)⁻²)`; it is 4 for an isometry and ∞ on a flip.
 //! * Newton: the 4×4 Hessian in `F` has the analytic eigensystem of isotropic energies
 //!   (Smith, de Goes, Kim 2019); for this energy only the twist mode can be negative, with
-//!   eigenvalue `2 − 2(‖F‖² − J)/J³`, and it is clamped to 0 (projection to PSD). Assembly
+//!   eigenvalue `2 − 2(‖F‖² − J)/J³`; it is clamped to 0 after a full step and replaced by
+//!   its absolute value after a truncated one (`abs_twist`, Chen et al. 2024). Assembly
 //!   uses a sparsity pattern fixed at start and one symbolic Cholesky reused every step.
 //! * Boundary barrier (ref. [30], Su et al.): for every boundary vertex `p` and boundary edge
 //!   `ab` not incident to it, the triangle-inequality gap `d = |p−a| + |p−b| − |a−b|`
@@ -37,6 +38,12 @@ pub struct SdOptions {
     /// theorem applies; symmetric, so solved by sparse Cholesky, ~5× faster than the LU that
     /// mean-value weights need; uniform weights are the certified fallback).
     pub init_weights: TutteWeights,
+    /// Start from the free-boundary least-squares conformal map ([`super::lscm()`]) when it
+    /// passes the exact certificate, else from the Tutte map [true]. The circle boundary of
+    /// the Tutte map squeezes triangles of curved patches to ~1e-7 of their area, and the
+    /// optimisation from there needs many more iterations and can end in a worse local
+    /// minimum with the boundary pressed against itself.
+    pub free_boundary_init: bool,
     /// Newton iteration budget [100]; running out is reported (`hit_budget`), not an error.
     pub max_iters: usize,
     /// Stop when a step decreases the energy excess `E − 4` over an isometry by less than
@@ -51,18 +58,28 @@ pub struct SdOptions {
     pub barrier_distance: f64,
     /// Weight of one barrier term relative to one average triangle's energy share [1.0].
     pub barrier_weight: f64,
+    /// Hessian projection of the twist mode: `true` replaces a negative eigenvalue by its
+    /// absolute value after an iteration whose step was truncated (Chen et al. 2024,
+    /// "trust-region eigenvalue filtering": far from the rest shape the clamped Hessian
+    /// over-trusts the twist direction, and the Armijo test then halves most steps) and
+    /// clamps it to 0 after a full step; `false` always clamps [true]. On the strongly curved cover
+    /// patches that start from the Tutte map this halves the final energy excess in the
+    /// same budget.
+    pub abs_twist: bool,
 }
 
 impl Default for SdOptions {
     fn default() -> Self {
         SdOptions {
             init_weights: TutteWeights::Cotan,
+            free_boundary_init: true,
             max_iters: 100,
             rel_tol: 1e-4,
             step_fraction: 0.9,
             armijo: 1e-4,
             barrier_distance: 0.02,
             barrier_weight: 1.0,
+            abs_twist: true,
         }
     }
 }
@@ -83,6 +100,10 @@ pub struct SdLog {
     pub min_double_area: Vec<f64>,
     /// Accepted step length (fraction of the Newton step) of each iteration.
     pub steps: Vec<f64>,
+    /// Largest flip-free step (before `step_fraction`) of each iteration.
+    pub flip_free_steps: Vec<f64>,
+    /// Line-search trials rejected by the Armijo test (or an infinite energy).
+    pub armijo_rejections: usize,
     /// Newton iterations taken.
     pub iterations: usize,
     /// The budget ran out before the stopping rule was met.
@@ -179,7 +200,11 @@ impl Pattern {
 /// Energy, gradient and projected Hessian of one triangle with respect to `vec(F)`
 /// (row-major `a, b, c, d`). `None` when `det F ≤ 0` (infinite energy).
 #[inline]
-fn sd_in_f(f: &nalgebra::Matrix2<f64>, hess: bool) -> Option<(f64, Vector4<f64>, Matrix4<f64>)> {
+fn sd_in_f(
+    f: &nalgebra::Matrix2<f64>,
+    hess: bool,
+    abs_twist: bool,
+) -> Option<(f64, Vector4<f64>, Matrix4<f64>)> {
     let (a, b, c, d) = (f[(0, 0)], f[(0, 1)], f[(1, 0)], f[(1, 1)]);
     let j = a * d - b * c;
     if j.is_nan() || j <= 0.0 {
@@ -214,7 +239,8 @@ fn sd_in_f(f: &nalgebra::Matrix2<f64>, hess: bool) -> Option<(f64, Vector4<f64>,
         if r > 0.0 {
             let (cs, sn) = (cs / r, sn / r);
             let q = Vector4::new(-sn, -cs, cs, -sn) * std::f64::consts::FRAC_1_SQRT_2;
-            h += q * q.transpose() * (-twist);
+            let lift = if abs_twist { -2.0 * twist } else { -twist };
+            h += q * q.transpose() * lift;
         }
     }
     Some((e, grad, h))
@@ -285,7 +311,7 @@ impl Problem<'_> {
                 continue;
             }
             let f = jacobian(fr, [uv[t[0].idx()], uv[t[1].idx()], uv[t[2].idx()]]);
-            match sd_in_f(&f, false) {
+            match sd_in_f(&f, false, false) {
                 Some((et, _, _)) => e += fr.area * et,
                 None => return f64::INFINITY,
             }
@@ -307,6 +333,7 @@ impl Problem<'_> {
         pat: &Pattern,
         grad: &mut [f64],
         vals: &mut [f64],
+        abs_twist: bool,
     ) -> Result<(), ParamError> {
         grad.iter_mut().for_each(|x| *x = 0.0);
         vals.iter_mut().for_each(|x| *x = 0.0);
@@ -315,7 +342,7 @@ impl Problem<'_> {
                 continue;
             }
             let f = jacobian(fr, [uv[t[0].idx()], uv[t[1].idx()], uv[t[2].idx()]]);
-            let (_, gf, hf) = sd_in_f(&f, true).ok_or_else(|| {
+            let (_, gf, hf) = sd_in_f(&f, true, abs_twist).ok_or_else(|| {
                 ParamError::NotCertified(format!("f{ti} is flipped during optimisation"))
             })?;
             let w = fr.area / self.total_area;
@@ -510,11 +537,12 @@ pub fn optimize_with_log(
     log.min_double_area
         .push(min_double_area(&uv, &disk.triangles));
     let mut converged = false;
+    let mut abs_twist = false;
     let mut trial = uv.clone();
     let mut probe = uv.clone();
     while log.iterations < options.max_iters {
         lap();
-        prob.assemble(&uv, &pat, &mut grad, &mut vals)?;
+        prob.assemble(&uv, &pat, &mut grad, &mut vals, abs_twist)?;
         log.time_ms[1] += lap();
         // Regularise the projected Hessian (translations and, at an isometry, rotations are
         // in its null space); grow the shift until the Cholesky factorisation succeeds.
@@ -568,7 +596,8 @@ pub fn optimize_with_log(
             converged = true; // no descent direction left
             break;
         }
-        let t_safe = options.step_fraction * prob.max_flip_free_step(&uv, &dir);
+        let t_flip = prob.max_flip_free_step(&uv, &dir);
+        let t_safe = options.step_fraction * t_flip;
         let mut t = t_safe.min(1.0);
         let mut accepted = None;
         for _ in 0..40 {
@@ -582,6 +611,8 @@ pub fn optimize_with_log(
                     break;
                 }
                 log.certificate_rejections += 1;
+            } else {
+                log.armijo_rejections += 1;
             }
             t *= 0.5;
         }
@@ -618,7 +649,12 @@ pub fn optimize_with_log(
         };
         std::mem::swap(&mut uv, &mut trial);
         log.iterations += 1;
+        // Trust-region-like switch (Chen et al. 2024): a truncated step means the quadratic
+        // model was not trusted, so filter the twist by its absolute value next time; a full
+        // (or extrapolated) step means the model is good, so clamp (faster near the optimum).
+        abs_twist = options.abs_twist && t < 1.0;
         log.steps.push(t);
+        log.flip_free_steps.push(t_flip);
         log.energies.push(e_new);
         log.min_double_area
             .push(min_double_area(&uv, &disk.triangles));
@@ -635,6 +671,14 @@ pub fn optimize_with_log(
     Ok((uv, log))
 }
 
+/// The LSCM of `disk` scaled to the 3D area, if it passes the exact certificate.
+fn certified_lscm(disk: &TriMesh, boundary: &[VertexId]) -> Option<Vec<Point2<f64>>> {
+    let mut uv = super::lscm(disk, boundary).ok()?;
+    scale_to_area(disk, &mut uv);
+    certify(disk, &uv, boundary).ok()?;
+    Some(uv)
+}
+
 impl Parameterizer for SymmetricDirichlet {
     fn name(&self) -> &'static str {
         "sd"
@@ -646,7 +690,15 @@ impl Parameterizer for SymmetricDirichlet {
         boundary: &[VertexId],
     ) -> Result<Parameterization, ParamError> {
         validate_disk(disk, boundary)?;
-        let (uv0, _) = certified_tutte(disk, boundary, self.options.init_weights)?;
+        let uv0 = match self
+            .options
+            .free_boundary_init
+            .then(|| certified_lscm(disk, boundary))
+            .flatten()
+        {
+            Some(uv) => uv,
+            None => certified_tutte(disk, boundary, self.options.init_weights)?.0,
+        };
         // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
         // finite float energy, or a failed factorisation), the certified Tutte map is returned.
         let (mut uv, log) = match optimize_with_log(disk, boundary, &uv0, &self.options) {
@@ -682,13 +734,13 @@ mod tests {
     use nalgebra::{Matrix2, SymmetricEigen};
 
     fn energy_of(f: &Matrix2<f64>) -> f64 {
-        sd_in_f(f, false).map_or(f64::INFINITY, |x| x.0)
+        sd_in_f(f, false, false).map_or(f64::INFINITY, |x| x.0)
     }
 
     #[test]
     fn gradient_and_hessian_match_finite_differences() {
         let f = Matrix2::new(1.3, 0.4, -0.2, 0.7);
-        let (_, g, _) = sd_in_f(&f, true).unwrap();
+        let (_, g, _) = sd_in_f(&f, true, false).unwrap();
         let h = 1e-6;
         for k in 0..4 {
             let mut fp = f;
@@ -704,14 +756,14 @@ mod tests {
         }
         // Unprojected Hessian (twist ≥ 0 here) against differences of the gradient.
         let f = Matrix2::new(1.5, 0.1, 0.05, 1.4);
-        let (_, _, hs) = sd_in_f(&f, true).unwrap();
+        let (_, _, hs) = sd_in_f(&f, true, false).unwrap();
         for k in 0..4 {
             let mut fp = f;
             let mut fm = f;
             fp[(k / 2, k % 2)] += h;
             fm[(k / 2, k % 2)] -= h;
-            let gp = sd_in_f(&fp, false).unwrap().1;
-            let gm = sd_in_f(&fm, false).unwrap().1;
+            let gp = sd_in_f(&fp, false, false).unwrap().1;
+            let gm = sd_in_f(&fm, false, false).unwrap().1;
             for r in 0..4 {
                 let fd = (gp[r] - gm[r]) / (2.0 * h);
                 assert!(
@@ -731,7 +783,7 @@ mod tests {
             Matrix2::new(2.0, 0.0, 0.0, 0.1),
             Matrix2::new(1.0, 0.0, 0.0, 1.0),
         ] {
-            let (_, _, hp) = sd_in_f(&f, true).unwrap();
+            let (_, _, hp) = sd_in_f(&f, true, false).unwrap();
             // Rebuild the raw Hessian: undo the projection by clamping eigenvalues ourselves.
             let eig = SymmetricEigen::new(hp);
             assert!(

@@ -1,0 +1,136 @@
+//! Diagnostics of the default parameterizer (Sec. 3.3) on the large patches of covering
+//! runs: per patch, the Newton iterations, the time split of `SdLog` and the energy / step
+//! trajectory. Run with `ONLY=armadillo MINF=3000 cargo run --release --example param_diag`.
+
+#[path = "../tests/common/param_cover.rs"]
+mod common;
+
+use common::{load, MESHES};
+use conemesh::param::{
+    circle_boundary, distortion, optimize_with_log, scale_to_area, tutte_embedding, SdOptions,
+    TutteWeights,
+};
+use conemesh::patches::{cover, extract_patch, ConePatches, CoverOptions};
+use rand::SeedableRng;
+use std::time::Instant;
+
+fn main() {
+    let only = std::env::var("ONLY").unwrap_or_else(|_| "armadillo".to_string());
+    let minf: usize = std::env::var("MINF")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3000);
+    let verbose = std::env::var("VERBOSE").is_ok();
+    let mut names: Vec<String> = std::fs::read_dir(MESHES)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().to_string())
+                .filter(|n| (n.ends_with(".off") || n.ends_with(".obj")) && n.contains(&only))
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    for name in names {
+        let Ok(mesh) = load(&name) else { continue };
+        let mut rng = conemesh::Rng::seed_from_u64(1);
+        let Ok(run) = cover(
+            &mesh,
+            &ConePatches::default(),
+            &CoverOptions::default(),
+            &mut rng,
+        ) else {
+            continue;
+        };
+        for (pi, p) in run.patches.iter().enumerate() {
+            if p.faces.len() < minf {
+                continue;
+            }
+            let Ok(pm) = extract_patch(&mesh, &p.faces) else {
+                continue;
+            };
+            let t0 = Instant::now();
+            let circle = circle_boundary(&pm.mesh, &pm.boundary, 1.0);
+            let Ok(mut uv0) = tutte_embedding(&pm.mesh, &pm.boundary, &circle, TutteWeights::Cotan)
+            else {
+                continue;
+            };
+            scale_to_area(&pm.mesh, &mut uv0);
+            if std::env::var("LSCM").is_ok() {
+                match conemesh::param::lscm(&pm.mesh, &pm.boundary) {
+                    Ok(mut l) => {
+                        scale_to_area(&pm.mesh, &mut l);
+                        match conemesh::invariants::certify_bijective(
+                            &l,
+                            &pm.mesh.triangles,
+                            &pm.boundary,
+                        ) {
+                            Ok(()) => uv0 = l,
+                            Err(e) => println!("  LSCM not certified: {e}"),
+                        }
+                    }
+                    Err(e) => println!("  LSCM failed: {e}"),
+                }
+            }
+            let t_init = t0.elapsed().as_secs_f64() * 1e3;
+            let mut opts = SdOptions::default();
+            let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
+            if let Some(x) = env("BW") {
+                opts.barrier_weight = x;
+            }
+            if let Some(x) = env("BD") {
+                opts.barrier_distance = x;
+            }
+            if let Some(x) = env("RT") {
+                opts.rel_tol = x;
+            }
+            if let Some(x) = env("MI") {
+                opts.max_iters = x as usize;
+            }
+            if let Some(x) = env("ABS") {
+                opts.abs_twist = x > 0.0;
+            }
+            if let Some(x) = env("SF") {
+                opts.step_fraction = x;
+            }
+            match optimize_with_log(&pm.mesh, &pm.boundary, &uv0, &opts) {
+                Ok((uv, log)) => {
+                    let total = t0.elapsed().as_secs_f64() * 1e3;
+                    let r = distortion(&pm.mesh, &uv);
+                    println!(
+                        "{name} p{pi} {}f: {:.0} ms (init {:.1}, setup {:.1} asm {:.1} solve {:.1} ls {:.1}) it {} budget {} E0 {:.3e} E {:.4} maxc {:.3} meanc {:.4} rej {} armijo {}",
+                        p.faces.len(),
+                        total,
+                        t_init,
+                        log.time_ms[0],
+                        log.time_ms[1],
+                        log.time_ms[2],
+                        log.time_ms[3],
+                        log.iterations,
+                        log.hit_budget,
+                        log.energies[0],
+                        log.energies.last().copied().unwrap_or(f64::NAN),
+                        r.max_conformal,
+                        r.mean_conformal,
+                        log.certificate_rejections,
+                        log.armijo_rejections
+                    );
+                    if verbose {
+                        for (i, e) in log.energies.iter().enumerate() {
+                            println!(
+                                "  {i:3} E {e:.6e} minA {:.3e} step {:.4} flipfree {:.4}",
+                                log.min_double_area[i],
+                                if i > 0 { log.steps[i - 1] } else { 0.0 },
+                                if i > 0 {
+                                    log.flip_free_steps[i - 1]
+                                } else {
+                                    0.0
+                                }
+                            );
+                        }
+                    }
+                }
+                Err(e) => println!("{name} p{pi}: {e}"),
+            }
+        }
+    }
+}
