@@ -214,3 +214,85 @@ fn unreferenced_vertices_are_not_samples() {
     assert!(d.hausdorff < 1e-12, "{d:?}");
     assert_eq!(d.samples, 2 * (a.n_vertices() + 1_000));
 }
+
+/// M_t is the mean of the three vertex tensors (not some other combination).
+#[test]
+fn face_metric_is_the_mean_of_the_vertex_metrics() {
+    use conemesh::quality::face_metric;
+    use conemesh::VertexId;
+    let m = [
+        Matrix3::from_diagonal(&Vector3::new(1.0, 2.0, 0.0)),
+        Matrix3::from_diagonal(&Vector3::new(4.0, 8.0, 0.0)),
+        Matrix3::from_diagonal(&Vector3::new(16.0, 32.0, 0.0)),
+    ];
+    let got = face_metric(&m, [VertexId(0), VertexId(1), VertexId(2)]);
+    assert_eq!(got, Matrix3::from_diagonal(&Vector3::new(7.0, 14.0, 0.0)));
+}
+
+/// The small- and large-angle percentages count exactly the triangles below/above the
+/// thresholds, over the number of triangles.
+#[test]
+fn angle_percentages_count_triangles_exactly() {
+    use conemesh::quality::stats_of;
+    use conemesh::quality::TriangleQuality;
+    let t = |a: f64, b: f64| TriangleQuality {
+        q: 0.5,
+        angles: [a, b, 180.0 - a - b],
+    };
+    // Min angles 15°, 25°, 60°, 5°; max angles 150°, 130°, 60°, 90°.
+    let qs = [t(15.0, 15.0), t(25.0, 25.0), t(60.0, 60.0), t(5.0, 85.0)];
+    let s = stats_of(&qs);
+    assert_eq!(s.pct_min_angle_lt_10, 25.0);
+    assert_eq!(s.pct_min_angle_lt_20, 50.0);
+    assert_eq!(s.pct_min_angle_lt_30, 75.0);
+    assert_eq!(s.pct_max_angle_gt_120, 50.0);
+    assert_eq!(s.theta_avg, (15.0 + 25.0 + 60.0 + 5.0) / 4.0);
+}
+
+/// The median of L/L_tar: the middle value for an odd edge count, the mean of the two middle
+/// values for an even one.
+#[test]
+fn conformity_median_for_odd_and_even_edge_counts() {
+    let id = |n: usize| vec![Matrix3::identity(); n];
+    // Two triangles sharing an edge: 5 edges of lengths 1, 1, √2, 2, √5 (sorted).
+    let kite = TriMesh::from_indices(
+        vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, 1.0, 0.0),
+            Point3::new(-1.0, -1.0, 0.0),
+        ],
+        &[[0, 1, 2], [0, 3, 1]],
+    )
+    .expect("valid");
+    let lens = {
+        let mut l: Vec<f64> = conemesh::quality::unique_edges(&kite)
+            .iter()
+            .map(|e| (kite.position(e.0) - kite.position(e.1)).norm())
+            .collect();
+        l.sort_by(f64::total_cmp);
+        l
+    };
+    assert_eq!(lens.len(), 5);
+    let c = edge_conformity(&kite, &id(4), 1.0);
+    assert!(
+        (c.median - lens[2]).abs() < 1e-15,
+        "{} vs {}",
+        c.median,
+        lens[2]
+    );
+    // A tetrahedron: 6 edges, 1, 1, 1, √2, √2, √2 → median (1 + √2)/2.
+    let tet = TriMesh::from_indices(
+        vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, 1.0, 0.0),
+            Point3::new(0.0, 0.0, 1.0),
+        ],
+        &[[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+    )
+    .expect("valid");
+    let c = edge_conformity(&tet, &id(4), 1.0);
+    assert_eq!(c.edges, 6);
+    assert!((c.median - (1.0 + 2f64.sqrt()) / 2.0).abs() < 1e-15);
+}

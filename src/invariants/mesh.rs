@@ -359,6 +359,29 @@ pub fn certify_boundary_preserved(before: &TriMesh, after: &TriMesh) -> Result<(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn boxes_overlap_needs_overlap_on_every_axis() {
+        let b = |lo: [f64; 3], hi: [f64; 3]| {
+            Aabb::new(
+                parry3d_f64::math::Vector::new(lo[0], lo[1], lo[2]),
+                parry3d_f64::math::Vector::new(hi[0], hi[1], hi[2]),
+            )
+        };
+        let unit = b([0.0; 3], [1.0; 3]);
+        assert!(
+            boxes_overlap(&unit, &b([1.0, 0.5, 0.5], [2.0, 2.0, 2.0])),
+            "touching counts"
+        );
+        for axis in 0..3 {
+            let mut lo = [0.25; 3];
+            let mut hi = [0.75; 3];
+            lo[axis] = 1.5;
+            hi[axis] = 2.0;
+            assert!(!boxes_overlap(&unit, &b(lo, hi)), "apart along axis {axis}");
+            assert!(!boxes_overlap(&b(lo, hi), &unit), "apart along axis {axis}");
+        }
+    }
+
     use super::*;
     use crate::mesh::generators;
 
