@@ -98,7 +98,7 @@ proptest! {
     #![proptest_config(config(24))]
 
     #[test]
-    fn stats_are_invariant_under_rigid_motion(seed in 0u64..1_000_000, angle in 0.0f64..6.28,
+    fn stats_are_invariant_under_rigid_motion(seed in 0u64..1_000_000, angle in 0.0f64..std::f64::consts::TAU,
                                               ax in -1.0f64..1.0, ay in -1.0f64..1.0, az in 0.1f64..1.0,
                                               tx in -10.0f64..10.0) {
         let (m, metrics) = mesh_and_metrics(seed);
@@ -138,7 +138,7 @@ proptest! {
 
     #[test]
     fn relative_distance_is_invariant_under_scaling_and_motion(seed in 0u64..1_000_000, s in 1e-2f64..1e2,
-                                                               angle in 0.0f64..6.28) {
+                                                               angle in 0.0f64..std::f64::consts::TAU) {
         let mut rng = Rng::seed_from_u64(seed);
         let a = generators::torus(1.0, 0.35, 14, 9);
         let b = generators::perturb(&a, 0.01, &mut rng);

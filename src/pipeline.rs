@@ -613,7 +613,7 @@ struct Failure {
     stage: &'static str,
     message: String,
     violation: Option<InvariantError>,
-    candidate: Option<Replacement>,
+    candidate: Option<Box<Replacement>>,
 }
 
 impl std::fmt::Display for Failure {
@@ -767,7 +767,7 @@ fn remesh_patch(
     times.certify += t0.elapsed().as_secs_f64();
     if let Err(e) = checked {
         let mut f = Failure::certificate("lifted faces", e);
-        f.candidate = Some(replacement);
+        f.candidate = Some(Box::new(replacement));
         return Err(f);
     }
     cert.no_degenerate += 1;
@@ -778,7 +778,7 @@ fn remesh_patch(
         times.certify += t0.elapsed().as_secs_f64();
         if let Err(e) = checked {
             let mut f = Failure::certificate("lifted faces", e);
-            f.candidate = Some(replacement);
+            f.candidate = Some(Box::new(replacement));
             return Err(f);
         }
         cert.locally_embedded += 1;

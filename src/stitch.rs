@@ -152,8 +152,8 @@ pub fn stitch(
     }
     let mut triangles = Vec::with_capacity(nf - patch_faces.len() + tris.len());
     let mut processed = Vec::with_capacity(triangles.capacity());
-    for f in 0..nf {
-        if !remove[f] {
+    for (f, gone) in remove.iter().enumerate() {
+        if !gone {
             triangles.push(work.mesh.triangles[f]);
             processed.push(work.processed[f]);
         }

@@ -248,13 +248,11 @@ fn compare(case: &str, m: &TriMesh, cgal: &Value) -> Vec<String> {
              {ours:?} vs CGAL {theirs:?}"
         ));
     }
-    if valid {
-        if rep.boundary_loops as u64 != cgal["boundary_cycles"].as_u64().unwrap_or(u64::MAX) {
-            diffs.push(format!(
-                "{case}: check_mesh boundary loops {} vs CGAL {}",
-                rep.boundary_loops, cgal["boundary_cycles"]
-            ));
-        }
+    if valid && rep.boundary_loops as u64 != cgal["boundary_cycles"].as_u64().unwrap_or(u64::MAX) {
+        diffs.push(format!(
+            "{case}: check_mesh boundary loops {} vs CGAL {}",
+            rep.boundary_loops, cgal["boundary_cycles"]
+        ));
     }
     diffs
 }

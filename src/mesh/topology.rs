@@ -155,13 +155,13 @@ impl Topology {
         let mut face_component = vec![0u32; nf];
         let mut root_label = vec![NONE; nf];
         let mut n_comp = 0u32;
-        for f in 0..nf {
+        for (f, label) in face_component.iter_mut().enumerate() {
             let r = find(&mut parent, f as u32) as usize;
             if root_label[r] == NONE {
                 root_label[r] = n_comp;
                 n_comp += 1;
             }
-            face_component[f] = root_label[r];
+            *label = root_label[r];
         }
 
         let mut topo = Topology {

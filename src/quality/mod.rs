@@ -86,7 +86,7 @@ pub fn triangle_quality_with_sqrt(p: [Point3<f64>; 3], q_t: &Matrix3<f64>) -> Tr
     let h = len[0].max(len[1]).max(len[2]);
     let semi = 0.5 * (len[0] + len[1] + len[2]);
     let finite = area.is_finite() && h.is_finite();
-    if !finite || len.iter().any(|&l| l == 0.0) || area == 0.0 {
+    if !finite || len.contains(&0.0) || area == 0.0 {
         // Degenerate in the metric: the corner opposite the longest edge gets 180°.
         let mut angles = [0.0; 3];
         let opposite_longest = (0..3)
