@@ -911,20 +911,7 @@ fn certify_candidate_embedded(
     patch_faces: &[FaceId],
     r: &Replacement,
 ) -> Result<(), InvariantError> {
-    use crate::stitch::PatchVertex;
-    let mut positions = work.mesh.positions.clone();
-    let base = positions.len() as u32;
-    positions.extend_from_slice(&r.new_positions);
-    let new_tris: Vec<[VertexId; 3]> = r
-        .triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| match v {
-                PatchVertex::Existing(g) => g,
-                PatchVertex::New(i) => VertexId(base + i),
-            })
-        })
-        .collect();
+    let (positions, new_tris) = candidate_arrays(work, r);
     let Some((lo, hi)) = bbox_of(new_tris.iter().flatten().map(|v| positions[v.idx()])) else {
         return Ok(());
     };
@@ -955,6 +942,29 @@ fn certify_candidate_embedded(
     } else {
         Err(InvariantError::SelfIntersections(Offenders(pairs)))
     }
+}
+
+/// The working mesh's positions followed by the candidate's new vertices, and the candidate's
+/// triangles in those ids (new vertex `i` is `n_vertices + i`).
+fn candidate_arrays(
+    work: &WorkingMesh,
+    r: &Replacement,
+) -> (Vec<nalgebra::Point3<f64>>, Vec<[VertexId; 3]>) {
+    use crate::stitch::PatchVertex;
+    let mut positions = work.mesh.positions.clone();
+    let base = positions.len() as u32;
+    positions.extend_from_slice(&r.new_positions);
+    let triangles = r
+        .triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| match v {
+                PatchVertex::Existing(g) => g,
+                PatchVertex::New(i) => VertexId(base + i),
+            })
+        })
+        .collect();
+    (positions, triangles)
 }
 
 fn bbox_of(
@@ -1025,21 +1035,8 @@ fn write_candidate(
     work: &WorkingMesh,
     r: &Replacement,
 ) -> Option<PathBuf> {
-    use crate::stitch::PatchVertex;
     let dir = options.debug_dir.as_ref()?;
-    let mut positions = work.mesh.positions.clone();
-    let base = positions.len() as u32;
-    positions.extend_from_slice(&r.new_positions);
-    let triangles = r
-        .triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| match v {
-                PatchVertex::Existing(g) => g,
-                PatchVertex::New(i) => VertexId(base + i),
-            })
-        })
-        .collect();
+    let (positions, triangles) = candidate_arrays(work, r);
     let (sub, _) = TriMesh {
         positions,
         triangles,
