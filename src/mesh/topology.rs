@@ -454,6 +454,37 @@ mod tests {
     use crate::mesh::generators;
     use nalgebra::Point3;
 
+    /// Two triangles sharing the edge (v0, v1): each is the other's only neighbour, across the
+    /// half-edge that runs along that edge; the other half-edges are boundary.
+    #[test]
+    fn neighbors_across_edges_and_vertex_neighbors() {
+        let m = TriMesh::from_indices(
+            vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(0.0, 1.0, 0.0),
+                Point3::new(0.0, -1.0, 0.0),
+            ],
+            &[[0, 1, 2], [1, 0, 3]],
+        )
+        .expect("valid");
+        let t = Topology::build(&m);
+        assert_eq!(t.neighbor(FaceId(0), 0), Some(FaceId(1)));
+        assert_eq!(t.neighbor(FaceId(1), 0), Some(FaceId(0)));
+        for i in 1..3 {
+            assert_eq!(t.neighbor(FaceId(0), i), None);
+            assert_eq!(t.neighbor(FaceId(1), i), None);
+        }
+        assert_eq!(
+            t.vertex_neighbors(VertexId(0)),
+            vec![VertexId(1), VertexId(2), VertexId(3)]
+        );
+        assert_eq!(
+            t.vertex_neighbors(VertexId(2)),
+            vec![VertexId(0), VertexId(1)]
+        );
+    }
+
     #[test]
     fn closed_surfaces_have_expected_genus() {
         let s = generators::icosphere(1.0, 2);
