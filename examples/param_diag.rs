@@ -89,6 +89,9 @@ fn main() {
             if let Some(x) = env("ABS") {
                 opts.abs_twist = x > 0.0;
             }
+            if let Some(x) = env("COLL") {
+                opts.collision_bound = x > 0.0;
+            }
             if let Some(x) = env("SF") {
                 opts.step_fraction = x;
             }
@@ -97,7 +100,7 @@ fn main() {
                     let total = t0.elapsed().as_secs_f64() * 1e3;
                     let r = distortion(&pm.mesh, &uv);
                     println!(
-                        "{name} p{pi} {}f: {:.0} ms (init {:.1}, setup {:.1} asm {:.1} solve {:.1} ls {:.1}) it {} budget {} E0 {:.3e} E {:.4} maxc {:.3} meanc {:.4} rej {} armijo {}",
+                        "{name} p{pi} {}f: {:.0} ms (init {:.1}, setup {:.1} asm {:.1} solve {:.1} ls {:.1}) it {} budget {} E0 {:.3e} E {:.4} maxc {:.3} meanc {:.4} rej {} armijo {} coll {}",
                         p.faces.len(),
                         total,
                         t_init,
@@ -112,7 +115,8 @@ fn main() {
                         r.max_conformal,
                         r.mean_conformal,
                         log.certificate_rejections,
-                        log.armijo_rejections
+                        log.armijo_rejections,
+                        log.collision_limited
                     );
                     if verbose {
                         for (i, e) in log.energies.iter().enumerate() {

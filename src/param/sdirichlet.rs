@@ -66,6 +66,10 @@ pub struct SdOptions {
     /// patches that start from the Tutte map this halves the final energy excess in the
     /// same budget.
     pub abs_twist: bool,
+    /// Cap every first trial step at `step_fraction` times the largest step along which no
+    /// boundary vertex meets a non-incident boundary edge (swept vertex–edge test), so the
+    /// certificate rarely rejects a trial for a self-touching boundary [true].
+    pub collision_bound: bool,
 }
 
 impl Default for SdOptions {
@@ -80,6 +84,7 @@ impl Default for SdOptions {
             barrier_distance: 0.02,
             barrier_weight: 1.0,
             abs_twist: true,
+            collision_bound: true,
         }
     }
 }
@@ -119,6 +124,8 @@ pub struct SdLog {
     /// Numeric Cholesky factorisations (more than one per iteration when the regularising
     /// shift had to grow).
     pub factorizations: usize,
+    /// Iterations whose first trial step was capped by the boundary-collision bound.
+    pub collision_limited: usize,
 }
 
 /// The fixed sparsity pattern of the 2n×2n Hessian (dof `2v + c`, full symmetric storage)
@@ -431,6 +438,117 @@ impl Problem<'_> {
     }
 }
 
+/// Largest `t ∈ (0, horizon]` such that along `uv + s·dir`, `s ∈ [0, t)`, no boundary vertex
+/// meets a boundary edge not incident to it (`horizon` if none does). Two moving segments
+/// first touch at an endpoint lying on the other segment, so this keeps a simple boundary
+/// polygon simple. For each pair the orientation `orient2d(a(s), b(s), p(s))` is a
+/// quadratic in `s`; its positive roots are where `p` crosses the moving line `ab`, and a
+/// root counts when `p` then lies on the segment (with a small margin: over-counting only
+/// shortens the step). Broad phase: sort-and-sweep on x over the boxes swept in
+/// `[0, horizon]`, like the certificate's. The exact certificate stays the final judge.
+fn max_collision_free_step(
+    uv: &[Point2<f64>],
+    dir: &[f64],
+    boundary: &[VertexId],
+    horizon: f64,
+) -> f64 {
+    let m = boundary.len();
+    if m < 4 || !(horizon > 0.0) {
+        return horizon;
+    }
+    let pos = |i: usize| uv[boundary[i % m].idx()];
+    let vel = |i: usize| {
+        let v = boundary[i % m].idx();
+        Vector2::new(dir[2 * v], dir[2 * v + 1])
+    };
+    // Items: 2i = vertex i, 2i + 1 = edge (i, i + 1); swept x-interval and y-interval.
+    let mut items: Vec<(f64, f64, f64, f64, usize)> = Vec::with_capacity(2 * m);
+    for i in 0..m {
+        let (p, q) = (pos(i), pos(i) + vel(i) * horizon);
+        items.push((
+            p.x.min(q.x),
+            p.x.max(q.x),
+            p.y.min(q.y),
+            p.y.max(q.y),
+            2 * i,
+        ));
+    }
+    for i in 0..m {
+        let (x0, x1, y0, y1, _) = items[i];
+        let (x2, x3, y2, y3, _) = items[(i + 1) % m];
+        items.push((x0.min(x2), x1.max(x3), y0.min(y2), y1.max(y3), 2 * i + 1));
+    }
+    items.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    let mut tmax = horizon;
+    let mut active: Vec<usize> = Vec::new();
+    let test = |vi: usize, ei: usize, tmax: &mut f64| {
+        if vi == ei || vi == (ei + 1) % m {
+            return;
+        }
+        let (p, a, b) = (pos(vi), pos(ei), pos(ei + 1));
+        let (dp, da, db) = (vel(vi), vel(ei), vel(ei + 1));
+        // orient(s) = (b − a + s(db − da)) × (p − a + s(dp − da)).
+        let (e, de) = (b - a, db - da);
+        let (w, dw) = (p - a, dp - da);
+        let c0 = e.perp(&w);
+        let c1 = e.perp(&dw) + de.perp(&w);
+        let c2 = de.perp(&dw);
+        let mut check = |s: f64| {
+            if s > 0.0 && s < *tmax {
+                let (es, ws) = (e + de * s, w + dw * s);
+                let l2 = es.norm_squared();
+                let u = if l2 > 0.0 { es.dot(&ws) / l2 } else { 0.5 };
+                if (-1e-6..=1.0 + 1e-6).contains(&u) {
+                    *tmax = s;
+                }
+            }
+        };
+        for r in quadratic_roots(c2, c1, c0) {
+            check(r);
+        }
+    };
+    for k in 0..items.len() {
+        let (x0, _, y0, y1, id) = items[k];
+        active.retain(|&j| items[j].1 >= x0);
+        for &j in &active {
+            let (_, _, yj0, yj1, jd) = items[j];
+            if yj1 < y0 || yj0 > y1 || (id & 1) == (jd & 1) {
+                continue;
+            }
+            let (v, e) = if id & 1 == 0 { (id, jd) } else { (jd, id) };
+            test(v / 2, e / 2, &mut tmax);
+        }
+        active.push(k);
+    }
+    tmax
+}
+
+/// Real roots of `a t² + b t + c` (numerically stable form; a degenerate quadratic gives
+/// its linear root).
+fn quadratic_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
+    if a.abs() <= 1e-300 || (a.abs() * c.abs() <= 1e-24 * b * b && b != 0.0) {
+        let mut r = Vec::new();
+        if b != 0.0 {
+            r.push(-c / b);
+        }
+        if a != 0.0 && b != 0.0 {
+            r.push(-b / a);
+        }
+        return r;
+    }
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return Vec::new();
+    }
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    if q != 0.0 {
+        vec![q / a, c / q]
+    } else {
+        let r = (-c / a).sqrt();
+        vec![r, -r]
+    }
+}
+
 /// Smallest positive root of `a t² + b t + c` (numerically stable form), if any.
 fn smallest_positive_root(a: f64, b: f64, c: f64) -> Option<f64> {
     let mut best: Option<f64> = None;
@@ -598,7 +716,18 @@ pub fn optimize_with_log(
         }
         let t_flip = prob.max_flip_free_step(&uv, &dir);
         let t_safe = options.step_fraction * t_flip;
-        let mut t = t_safe.min(1.0);
+        // Boundary-collision bound over the steps the first trial can reach (the
+        // extrapolation beyond it is judged by the certificate alone).
+        let horizon = t_flip.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
+        let t_coll = if options.collision_bound {
+            max_collision_free_step(&uv, &dir, boundary, horizon)
+        } else {
+            horizon
+        };
+        if t_coll < horizon {
+            log.collision_limited += 1;
+        }
+        let mut t = (options.step_fraction * t_coll).min(1.0);
         let mut accepted = None;
         for _ in 0..40 {
             for v in 0..n {
