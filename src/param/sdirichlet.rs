@@ -70,6 +70,9 @@ pub struct SdOptions {
     /// boundary vertex meets a non-incident boundary edge (swept vertex–edge test), so the
     /// certificate rarely rejects a trial for a self-touching boundary [true].
     pub collision_bound: bool,
+    /// When the LSCM is not certified, start from the Tutte map onto the ellipse of the
+    /// LSCM boundary before falling back to the circle [true].
+    pub shaped_tutte_init: bool,
 }
 
 impl Default for SdOptions {
@@ -85,6 +88,7 @@ impl Default for SdOptions {
             barrier_weight: 1.0,
             abs_twist: true,
             collision_bound: true,
+            shaped_tutte_init: false,
         }
     }
 }
@@ -800,12 +804,50 @@ pub fn optimize_with_log(
     Ok((uv, log))
 }
 
-/// The LSCM of `disk` scaled to the 3D area, if it passes the exact certificate.
-fn certified_lscm(disk: &TriMesh, boundary: &[VertexId]) -> Option<Vec<Point2<f64>>> {
-    let mut uv = super::lscm(disk, boundary).ok()?;
-    scale_to_area(disk, &mut uv);
-    certify(disk, &uv, boundary).ok()?;
-    Some(uv)
+/// Which initial map [`initial_map`] chose.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum InitialMap {
+    /// The free-boundary LSCM passed the certificate.
+    Lscm,
+    /// Tutte map onto the ellipse of the (overlapping) LSCM boundary.
+    EllipseTutte,
+    /// Tutte map onto a circle (the certified fallback).
+    CircleTutte,
+}
+
+/// The certified initial map of [`SymmetricDirichlet`], scaled to the 3D area: the LSCM if
+/// it passes the exact certificate; else (`shaped_tutte_init`) the Tutte map onto the
+/// ellipse of the LSCM boundary ([`super::ellipse_boundary`], strictly convex, so Tutte's
+/// theorem applies) if it passes; else the circle Tutte map (`init_weights`, then uniform).
+pub fn initial_map(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    options: &SdOptions,
+) -> Result<(Vec<Point2<f64>>, InitialMap), ParamError> {
+    if options.free_boundary_init {
+        if let Ok(mut uv) = super::lscm(disk, boundary) {
+            scale_to_area(disk, &mut uv);
+            if certify(disk, &uv, boundary).is_ok() {
+                return Ok((uv, InitialMap::Lscm));
+            }
+            if options.shaped_tutte_init {
+                if let Some(shape) = super::ellipse_boundary(disk, boundary, &uv) {
+                    if let Ok(mut t) =
+                        super::tutte_embedding(disk, boundary, &shape, options.init_weights)
+                    {
+                        scale_to_area(disk, &mut t);
+                        if certify(disk, &t, boundary).is_ok() {
+                            return Ok((t, InitialMap::EllipseTutte));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok((
+        certified_tutte(disk, boundary, options.init_weights)?.0,
+        InitialMap::CircleTutte,
+    ))
 }
 
 impl Parameterizer for SymmetricDirichlet {
@@ -819,15 +861,7 @@ impl Parameterizer for SymmetricDirichlet {
         boundary: &[VertexId],
     ) -> Result<Parameterization, ParamError> {
         validate_disk(disk, boundary)?;
-        let uv0 = match self
-            .options
-            .free_boundary_init
-            .then(|| certified_lscm(disk, boundary))
-            .flatten()
-        {
-            Some(uv) => uv,
-            None => certified_tutte(disk, boundary, self.options.init_weights)?.0,
-        };
+        let (uv0, _) = initial_map(disk, boundary, &self.options)?;
         // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
         // finite float energy, or a failed factorisation), the certified Tutte map is returned.
         let (mut uv, log) = match optimize_with_log(disk, boundary, &uv0, &self.options) {
@@ -942,6 +976,34 @@ mod tests {
                 * e.eigenvectors.transpose();
             assert!((clamped - hp).norm() < 1e-8 * hp.norm(), "{f}");
         }
+    }
+
+    #[test]
+    fn collision_bound_stops_a_vertex_at_the_opposite_edge() {
+        // Boundary square 0..4 plus vertex 4 on the bottom edge's midline, moving up.
+        // Loop (0,0) (2,0) (2,2) (1,1.5) (0,2): vertex 3 at (1, 1.5) moving down by 2 per
+        // unit step reaches the bottom edge (0,0)-(2,0) at t = 0.75.
+        let uv = [
+            Point2::new(0.0, 0.0),
+            Point2::new(2.0, 0.0),
+            Point2::new(2.0, 2.0),
+            Point2::new(1.0, 1.5),
+            Point2::new(0.0, 2.0),
+        ];
+        let boundary: Vec<VertexId> = (0..5).map(VertexId::new).collect();
+        let mut dir = vec![0.0; 10];
+        dir[7] = -2.0;
+        let t = max_collision_free_step(&uv, &dir, &boundary, 10.0);
+        assert!((t - 0.75).abs() < 1e-12, "{t}");
+        // Moving sideways instead, it never meets a non-incident edge within the horizon.
+        dir[7] = 0.0;
+        dir[6] = 0.1;
+        assert_eq!(max_collision_free_step(&uv, &dir, &boundary, 1.0), 1.0);
+        // A vertex passing beside an edge's line but outside the segment is not a collision.
+        dir[6] = 0.0;
+        dir[7] = 0.0;
+        dir[0] = -1.0; // v0 moves left along the x axis: the line of edge (1,2) is x = 2
+        assert_eq!(max_collision_free_step(&uv, &dir, &boundary, 5.0), 5.0);
     }
 
     #[test]
