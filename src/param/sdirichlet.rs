@@ -461,7 +461,7 @@ fn max_collision_free_step(
     horizon: f64,
 ) -> f64 {
     let m = boundary.len();
-    if m < 4 || !(horizon > 0.0) {
+    if m < 4 || horizon.is_nan() || horizon <= 0.0 {
         return horizon;
     }
     let pos = |i: usize| uv[boundary[i % m].idx()];

@@ -31,7 +31,7 @@ pub fn ellipse_boundary(
         w_sum += l;
         c += (q(i).coords + q(i + 1).coords) * (0.5 * l);
     }
-    if !(w_sum > 0.0) {
+    if w_sum.is_nan() || w_sum <= 0.0 {
         return None;
     }
     c /= w_sum;
@@ -91,7 +91,7 @@ pub fn ellipse_boundary(
         .map(|i| (disk.position(boundary[(i + 1) % m]) - disk.position(boundary[i])).norm())
         .collect();
     let total: f64 = len.iter().sum();
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return None;
     }
     let mut s = 0.0;
