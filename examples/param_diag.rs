@@ -71,6 +71,20 @@ fn main() {
                     Err(e) => println!("  LSCM failed: {e}"),
                 }
             }
+            // INIT=1: the parameterizer's own initial map (INIT=0: without the ellipse Tutte).
+            if let Ok(v) = std::env::var("INIT") {
+                let o = SdOptions {
+                    shaped_tutte_init: v != "0",
+                    ..Default::default()
+                };
+                match conemesh::param::initial_map(&pm.mesh, &pm.boundary, &o) {
+                    Ok((u, kind)) => {
+                        println!("  init {kind:?}");
+                        uv0 = u;
+                    }
+                    Err(e) => println!("  init failed: {e}"),
+                }
+            }
             let t_init = t0.elapsed().as_secs_f64() * 1e3;
             let mut opts = SdOptions::default();
             let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
@@ -89,6 +103,9 @@ fn main() {
             if let Some(x) = env("ABS") {
                 opts.abs_twist = x > 0.0;
             }
+            if let Some(x) = env("COLL") {
+                opts.collision_bound = x > 0.0;
+            }
             if let Some(x) = env("SF") {
                 opts.step_fraction = x;
             }
@@ -97,7 +114,7 @@ fn main() {
                     let total = t0.elapsed().as_secs_f64() * 1e3;
                     let r = distortion(&pm.mesh, &uv);
                     println!(
-                        "{name} p{pi} {}f: {:.0} ms (init {:.1}, setup {:.1} asm {:.1} solve {:.1} ls {:.1}) it {} budget {} E0 {:.3e} E {:.4} maxc {:.3} meanc {:.4} rej {} armijo {}",
+                        "{name} p{pi} {}f: {:.0} ms (init {:.1}, setup {:.1} asm {:.1} solve {:.1} ls {:.1}) it {} budget {} E0 {:.3e} E {:.4} maxc {:.3} meanc {:.4} rej {} armijo {} coll {} fact {}",
                         p.faces.len(),
                         total,
                         t_init,
@@ -112,7 +129,9 @@ fn main() {
                         r.max_conformal,
                         r.mean_conformal,
                         log.certificate_rejections,
-                        log.armijo_rejections
+                        log.armijo_rejections,
+                        log.collision_limited,
+                        log.factorizations
                     );
                     if verbose {
                         for (i, e) in log.energies.iter().enumerate() {

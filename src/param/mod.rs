@@ -4,11 +4,15 @@
 mod distortion;
 mod lscm;
 mod sdirichlet;
+mod shaped;
 mod tutte;
 
 pub use distortion::{distortion, triangle_frames, TriangleFrame};
 pub use lscm::lscm;
-pub use sdirichlet::{optimize_with_log, SdLog, SdOptions, SymmetricDirichlet};
+pub use sdirichlet::{
+    initial_map, optimize_with_log, InitialMap, SdLog, SdOptions, SymmetricDirichlet,
+};
+pub use shaped::ellipse_boundary;
 pub use tutte::{circle_boundary, scale_to_area, tutte_embedding, Tutte, TutteWeights};
 
 use crate::ids::VertexId;
