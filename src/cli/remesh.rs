@@ -145,13 +145,12 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         ProgressBar::hidden()
     } else {
         let b = ProgressBar::new(total);
-        b.set_style(
-            ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:40}] {pos}/{len} input faces covered, {msg}",
-            )
-            .expect("static template")
-            .progress_chars("=> "),
-        );
+        // A constant template; should it ever be refused, keep indicatif's default style.
+        if let Ok(style) = ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} input faces covered, {msg}",
+        ) {
+            b.set_style(style.progress_chars("=> "));
+        }
         b
     };
     let result = pipeline::remesh(&field, &stages, &options, |p: Progress| {
