@@ -13,6 +13,7 @@
 
 pub mod check;
 pub mod error;
+pub mod fidelity;
 pub mod ids;
 pub mod invariants;
 pub mod io;

@@ -17,6 +17,7 @@
 //! Everything runs in the unit-diagonal space of the metric field's reference mesh
 //! (`crate::metric::Normalization`); the caller maps the result back to file units.
 
+use crate::fidelity::{self, FidelityOptions, LiftedPatch};
 use crate::ids::{EdgeKey, FaceId, PatchId, VertexId};
 use crate::invariants::{self, InvariantError, Offenders};
 use crate::lift::{lift, PatchFrame};
@@ -29,7 +30,7 @@ use crate::remesh2d::{
     transfer_metric, Lct, PlanarDomain, PlanarMetricField, PlanarRemesher, TransferMethod,
 };
 use crate::stitch::{stitch, Replacement, WorkingMesh};
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Point3, Vector3};
 use rand::SeedableRng;
 use serde::Serialize;
 use std::collections::HashSet;
@@ -123,6 +124,10 @@ pub struct RemeshOptions {
     /// Stop at the first failed patch attempt instead of shrinking the patch and retrying
     /// (for invariant-checking runs that want every failure to be an error).
     pub strict: bool,
+    /// Geometric fidelity control (our addition, [`crate::fidelity`]): patches whose lifted
+    /// triangles deviate from the reference by more than `max_deviation` are remeshed again
+    /// with the metric scaled up there.
+    pub fidelity: FidelityOptions,
 }
 
 impl Default for RemeshOptions {
@@ -135,6 +140,7 @@ impl Default for RemeshOptions {
             debug_dir: None,
             max_patches: None,
             strict: false,
+            fidelity: FidelityOptions::default(),
         }
     }
 }
@@ -172,6 +178,8 @@ pub struct StageTimes {
     pub remesh2d: f64,
     /// Lifting and projection.
     pub lift: f64,
+    /// Fidelity measurement (the extra remeshing rounds count under `remesh2d` / `lift`).
+    pub fidelity: f64,
     /// Stitching.
     pub stitch: f64,
     /// Working-mesh certificates after every patch.
@@ -241,6 +249,8 @@ pub struct PatchRecord {
     pub retries: usize,
     /// Even the smallest attempt failed: the faces were kept unchanged.
     pub kept: bool,
+    /// Extra remeshing rounds of the fidelity control.
+    pub fidelity_rounds: usize,
 }
 
 /// The outcome of Algorithm 1.
@@ -331,8 +341,43 @@ pub fn remesh(
             "target edge length {l_tar} is not a positive finite number (L_avg = {l_avg})"
         )));
     }
+    let eps = options.fidelity.max_deviation;
+    if !(eps.is_finite() && eps >= 0.0) {
+        return Err(PipelineError::Input(format!(
+            "fidelity tolerance {eps} is not a finite number ≥ 0"
+        )));
+    }
+    // A-priori fidelity scaling (our addition, `crate::fidelity::a_priori_scale`): the
+    // metric is scaled up isotropically where a triangle of the target size would cut off
+    // more of the reference than the tolerance allows. L_tar above is from the unscaled
+    // metric, as is every quality measure.
+    let scaled_field;
+    let mut fid_scale: Vec<f64> = Vec::new();
+    let field = if options.fidelity.max_deviation > 0.0 {
+        let topo = Topology::build(reference);
+        let s = fidelity::a_priori_scale(
+            reference,
+            &topo,
+            field.vertex_metrics(),
+            l_tar,
+            options.fidelity.max_deviation,
+        );
+        let metrics = field
+            .vertex_metrics()
+            .iter()
+            .zip(&s)
+            .map(|(m, f)| m * *f)
+            .collect();
+        fid_scale = s;
+        scaled_field = MetricField::new(reference.clone(), metrics)
+            .map_err(|e| PipelineError::Input(format!("fidelity-scaled metric: {e}")))?;
+        &scaled_field
+    } else {
+        field
+    };
     let mut rng = crate::Rng::seed_from_u64(options.seed);
     let flip_test = FlipTest::new(reference);
+    let ref_normals = fidelity::vertex_normals(reference);
     // Candidates are checked for local self-intersections only when the input is embedded
     // (an input that self-intersects cannot be replaced by an embedded surface on it).
     let input_pairs = if options.check_self_intersections {
@@ -366,6 +411,7 @@ pub fn remesh(
 
     let mut n_patch = 0usize;
     let mut fallback = Fallbacks::default();
+
     loop {
         if work.unprocessed() == 0 {
             break;
@@ -435,6 +481,8 @@ pub fn remesh(
                 &work,
                 &topo,
                 &flip_test,
+                &ref_normals,
+                &fid_scale,
                 embedded_input,
                 &faces,
                 l_tar,
@@ -443,7 +491,7 @@ pub fn remesh(
                 &mut cert,
             );
             match attempt {
-                Ok((replacement, distortion)) => {
+                Ok((replacement, distortion, fidelity_rounds)) => {
                     let t0 = Instant::now();
                     let new_faces = stitch(&mut work, &faces, &replacement).map_err(|e| {
                         PipelineError::Stage {
@@ -466,6 +514,7 @@ pub fn remesh(
                             distortion,
                             retries: 0,
                             kept: false,
+                            fidelity_rounds,
                         },
                     );
                 }
@@ -494,6 +543,7 @@ pub fn remesh(
                                 distortion: DistortionReport::default(),
                                 retries: 0,
                                 kept: true,
+                                fidelity_rounds: 0,
                             },
                         );
                     }
@@ -681,13 +731,15 @@ fn remesh_patch(
     work: &WorkingMesh,
     topo: &Topology,
     flip_test: &FlipTest,
+    ref_normals: &[Vector3<f64>],
+    fid_scale: &[f64],
     embedded_input: bool,
     faces: &[FaceId],
     l_tar: f64,
     rng: &mut crate::Rng,
     times: &mut StageTimes,
     cert: &mut Certificate,
-) -> Result<(Replacement, DistortionReport), Failure> {
+) -> Result<(Replacement, DistortionReport, usize), Failure> {
     let reference = field.reference();
     let disk =
         extract_patch(&work.mesh, faces).map_err(|e| Failure::stage("patch extraction", e))?;
@@ -710,10 +762,29 @@ fn remesh_patch(
     // (c) metric transfer (Eq. 4): the 3D metric is read from the reference field at each
     // patch vertex's reference location and carried to the plane.
     let t0 = Instant::now();
+    let boost = if fid_scale.is_empty() {
+        Vec::new()
+    } else {
+        fidelity::patch_vertex_factors(field, fid_scale, &disk.mesh)
+    };
     let metrics3d: Vec<Matrix3<f64>> = disk
         .to_global
         .iter()
-        .map(|g| field.eval_at(&work.locations[g.idx()]))
+        .enumerate()
+        .map(|(i, g)| {
+            let loc = &work.locations[g.idx()];
+            let m = field.eval_at(loc);
+            // The field already carries the interpolated a-priori factor; raise it to the
+            // largest factor of the reference vertices under this vertex's faces.
+            match boost.get(i) {
+                Some(&b) if b > 1.0 => {
+                    let t = reference.face(loc.face);
+                    let here: f64 = (0..3).map(|k| loc.bary[k] * fid_scale[t[k].idx()]).sum();
+                    m * (b / here).max(1.0)
+                }
+                _ => m,
+            }
+        })
         .collect();
     let metrics2d = transfer_metric(&disk.mesh, &param.uv, &metrics3d, options.transfer)
         .map_err(|e| Failure::stage("metric transfer", e))?;
@@ -723,43 +794,96 @@ fn remesh_patch(
         .iter()
         .map(|t| [t[0].0, t[1].0, t[2].0])
         .collect();
-    let planar_field = PlanarMetricField::new(param.uv.clone(), tris_u32.clone(), metrics2d)
-        .map_err(|e| Failure::stage("metric transfer", e))?;
     times.transfer += t0.elapsed().as_secs_f64();
 
-    // (d) planar remeshing with the patch boundary fixed, certified.
-    let t0 = Instant::now();
+    // (d) planar remeshing with the patch boundary fixed, certified; (e) map back:
+    // barycentric location in the initial 2D mesh, then onto the reference. Repeated with the
+    // metric scaled up where the lifted patch deviates from the reference by more than the
+    // fidelity tolerance (our addition, `crate::fidelity`).
     let domain = PlanarDomain {
         points: param.uv.clone(),
-        triangles: tris_u32,
+        triangles: tris_u32.clone(),
         boundary: disk.boundary.iter().map(|v| v.0).collect(),
         constrained_edges: Vec::new(),
     };
-    let planar = stages
-        .remesher
-        .remesh(&domain, &planar_field, l_tar, rng)
-        .map_err(|e| Failure::stage("planar remeshing", e))?;
-    invariants::certify_planar(&domain, &planar)
-        .map_err(|e| Failure::certificate("planar remeshing", e))?;
-    cert.planar += 1;
-    times.remesh2d += t0.elapsed().as_secs_f64();
-
-    // (e) map back: barycentric location in the initial 2D mesh, then onto the reference.
-    let t0 = Instant::now();
     let frame = PatchFrame {
         triangles: &disk.mesh.triangles,
         positions: &disk.mesh.positions,
         to_global: &disk.to_global,
     };
-    let replacement = lift(
-        &planar,
-        &frame,
-        |p| planar_field.locate(p),
-        |p| field.project(p).0,
-        reference,
-    )
-    .map_err(|e| Failure::stage("mapping back", e))?;
-    times.lift += t0.elapsed().as_secs_f64();
+    let mut metrics2d = metrics2d;
+    let mut rounds = 0usize;
+    let replacement = loop {
+        let t0 = Instant::now();
+        let planar_field =
+            PlanarMetricField::new(param.uv.clone(), tris_u32.clone(), metrics2d.clone())
+                .map_err(|e| Failure::stage("metric transfer", e))?;
+        let planar = stages
+            .remesher
+            .remesh(&domain, &planar_field, l_tar, rng)
+            .map_err(|e| Failure::stage("planar remeshing", e))?;
+        invariants::certify_planar(&domain, &planar)
+            .map_err(|e| Failure::certificate("planar remeshing", e))?;
+        cert.planar += 1;
+        times.remesh2d += t0.elapsed().as_secs_f64();
+
+        let t0 = Instant::now();
+        let replacement = lift(
+            &planar,
+            &frame,
+            |p| planar_field.locate(p),
+            |p| field.project(p).0,
+            reference,
+        )
+        .map_err(|e| Failure::stage("mapping back", e))?;
+        times.lift += t0.elapsed().as_secs_f64();
+
+        let eps = options.fidelity.max_deviation;
+        if !(eps > 0.0) || rounds >= options.fidelity.rounds {
+            break replacement;
+        }
+        let t0 = Instant::now();
+        let mut next_new = 0usize;
+        let positions: Vec<Point3<f64>> = planar
+            .origin
+            .iter()
+            .map(|o| match o {
+                Some(o) => disk.mesh.positions[*o as usize],
+                None => {
+                    next_new += 1;
+                    replacement.new_positions[next_new - 1]
+                }
+            })
+            .collect();
+        let fixed: Vec<bool> = planar.origin.iter().map(Option::is_some).collect();
+        let deviating = fidelity::deviations(
+            field,
+            ref_normals,
+            &LiftedPatch {
+                positions: &positions,
+                fixed: &fixed,
+                triangles: &planar.triangles,
+            },
+            eps,
+        );
+        let scaled = if deviating.is_empty() {
+            0
+        } else {
+            fidelity::scale_metric(
+                &mut metrics2d,
+                &planar_field,
+                &planar,
+                &deviating,
+                eps,
+                options.fidelity.max_factor,
+            )
+        };
+        times.fidelity += t0.elapsed().as_secs_f64();
+        if scaled == 0 {
+            break replacement;
+        }
+        rounds += 1;
+    };
 
     // (f) certify the candidate's new faces before touching the working mesh.
     let t0 = Instant::now();
@@ -783,7 +907,7 @@ fn remesh_patch(
         }
         cert.locally_embedded += 1;
     }
-    Ok((replacement, param.report))
+    Ok((replacement, param.report, rounds))
 }
 
 /// A smaller disk inside `faces`: grown face by face (breadth first, exact disk rule) from

@@ -55,6 +55,11 @@ pub struct RemeshArgs {
     /// Skip the final exact self-intersection test.
     #[arg(long)]
     pub no_self_intersections: bool,
+    /// Fidelity tolerance, relative to the input's bounding-box diagonal: the metric is
+    /// scaled up where a target-size triangle would cut more than this off the surface
+    /// (tips, rims, creases). 0 turns the control off (the paper's metric alone).
+    #[arg(long, default_value_t = conemesh::fidelity::FidelityOptions::default().max_deviation)]
+    pub hausd: f64,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -131,6 +136,10 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             None => TargetLength::Factor(args.ltar_factor),
         },
         check_self_intersections: !args.no_self_intersections,
+        fidelity: conemesh::fidelity::FidelityOptions {
+            max_deviation: args.hausd,
+            ..Default::default()
+        },
         debug_dir: Some(args.debug_dir.clone().unwrap_or_else(|| {
             args.output
                 .parent()

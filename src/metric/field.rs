@@ -213,6 +213,22 @@ impl MetricField {
         (loc, loc.position(&self.reference))
     }
 
+    /// Reference faces whose bounding boxes meet the axis-aligned box `[lo, hi]` (parry's
+    /// BVH), ascending. Used to find the part of the reference surface under a patch.
+    pub fn faces_in_box(&self, lo: &Point3<f64>, hi: &Point3<f64>) -> Vec<FaceId> {
+        let aabb = parry3d_f64::bounding_volume::Aabb::new(to_parry(lo), to_parry(hi));
+        let mut faces: Vec<FaceId> = self
+            .bvh
+            .bvh()
+            .intersect_aabb(&aabb)
+            .filter(|&f| (f as usize) < self.reference.n_faces())
+            .map(FaceId)
+            .collect();
+        faces.sort_unstable();
+        faces.dedup();
+        faces
+    }
+
     /// The metric at a surface location: `Σ bᵢ Mᵢ` over the face's corners (Sec. 4.1).
     /// Exactly the vertex tensor at a corner (`bary = [1, 0, 0]`).
     pub fn eval_at(&self, loc: &SurfaceLocation) -> Matrix3<f64> {
