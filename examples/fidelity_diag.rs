@@ -8,7 +8,9 @@ use conemesh::{FaceId, TriMesh};
 use nalgebra::Point3;
 
 fn load(p: &str) -> TriMesh {
-    let m = conemesh::io::read_mesh(std::path::Path::new(p)).expect("read").mesh;
+    let m = conemesh::io::read_mesh(std::path::Path::new(p))
+        .expect("read")
+        .mesh;
     m.without_unreferenced_vertices().0
 }
 
@@ -20,8 +22,7 @@ fn main() {
     let norm = Normalization::of(&input);
     let (ui, uo) = (norm.apply(&input), norm.apply(&output));
     let pc5 = principal_curvatures(&ui, &CurvatureOptions::default()).expect("pc");
-    let pc2 = principal_curvatures(&ui, &CurvatureOptions { radius: 2, ..Default::default() })
-        .expect("pc");
+    let pc2 = principal_curvatures(&ui, &CurvatureOptions { radius: 2 }).expect("pc");
     let pi = SurfaceProjector::new(&ui);
     let po = SurfaceProjector::new(&uo);
     // Dense samples: vertices + 20 points per face, deterministic.
@@ -32,7 +33,9 @@ fn main() {
             for i in 1..5 {
                 for j in 1..(5 - i) {
                     let (u, w) = (i as f64 / 5.0, j as f64 / 5.0);
-                    v.push(Point3::from(p.coords * (1.0 - u - w) + q.coords * u + r.coords * w));
+                    v.push(Point3::from(
+                        p.coords * (1.0 - u - w) + q.coords * u + r.coords * w,
+                    ));
                 }
             }
         }
@@ -48,7 +51,7 @@ fn main() {
             })
             .expect("3")
     };
-    for (name, from, to, tomesh) in [("input→output", &ui, &po, &uo), ("output→input", &uo, &pi, &ui)] {
+    for (name, from, to) in [("input→output", &ui, &po), ("output→input", &uo, &pi)] {
         let mut d: Vec<(f64, Point3<f64>)> = samples(from)
             .into_iter()
             .filter_map(|p| to.closest(&p).map(|(_, _, d)| (d, p)))
@@ -77,7 +80,6 @@ fn main() {
                 100.0 * k5.k1.abs().max(k5.k2.abs()) * h * h / 8.0,
                 100.0 * k2.k1.abs().max(k2.k2.abs()) * h * h / 8.0,
             );
-            let _ = tomesh;
         }
     }
 }

@@ -12,8 +12,8 @@
 //! tensor), so the triangles keep the metric's anisotropy and their shape quality in it.
 
 use crate::ids::VertexId;
-use crate::metric::MetricField;
 use crate::mesh::TriMesh;
+use crate::metric::MetricField;
 use crate::remesh2d::{PlanarMesh, PlanarMetricField};
 use nalgebra::{Matrix2, Point2, Point3, Vector3};
 use parry3d_f64::math::Vector as PVec;
@@ -147,8 +147,8 @@ pub fn deviations(
         ref_vertices.dedup();
         for r in ref_vertices {
             let x = reference.positions[r.idx()];
-            let (proj, (t, loc)) = bvh
-                .project_local_point_and_get_location(PVec::new(x.x, x.y, x.z), false);
+            let (proj, (t, loc)) =
+                bvh.project_local_point_and_get_location(PVec::new(x.x, x.y, x.z), false);
             let t = t as usize;
             let Some(tri) = patch.triangles.get(t) else {
                 continue;
@@ -198,9 +198,11 @@ pub fn deviations(
 
 fn bbox(points: &[Point3<f64>]) -> Option<(Point3<f64>, Point3<f64>)> {
     let first = points.first()?;
-    Some(points.iter().fold((*first, *first), |(lo, hi), q| {
-        (lo.inf(q), hi.sup(q))
-    }))
+    Some(
+        points
+            .iter()
+            .fold((*first, *first), |(lo, hi), q| (lo.inf(q), hi.sup(q))),
+    )
 }
 
 /// Scale the transferred metric (one tensor per vertex of the initial 2D mesh) up around the
@@ -226,7 +228,8 @@ pub fn scale_metric(
             continue;
         };
         let corners = tri.map(|i| planar.points[i as usize]);
-        let centroid = Point2::from((corners[0].coords + corners[1].coords + corners[2].coords) / 3.0);
+        let centroid =
+            Point2::from((corners[0].coords + corners[1].coords + corners[2].coords) / 3.0);
         for q in corners.iter().chain(std::iter::once(&centroid)) {
             if let Some((it, _)) = field.locate(q) {
                 for v in init[it] {
@@ -291,7 +294,7 @@ pub fn a_priori_scale(
             let v = VertexId::new(vi);
             let nv = normals[vi];
             let nn = nv.norm();
-            if !(nn > 0.0) || topo.vertex_faces(v).is_empty() {
+            if nn.is_nan() || nn <= 0.0 || topo.vertex_faces(v).is_empty() {
                 return 1.0;
             }
             let nv = nv / nn;
@@ -299,7 +302,7 @@ pub fn a_priori_scale(
             // direction of strongest curvature, where tips, rims and creases are cut; the
             // long axis of an anisotropic metric follows the weak curvature by design.
             let lmax = metrics[vi].symmetric_eigenvalues().max();
-            if !(lmax > 0.0) {
+            if lmax.is_nan() || lmax <= 0.0 {
                 return 1.0;
             }
             // Where the curvature is at its floor (flat parts) the nominal edge is longer than
@@ -367,11 +370,7 @@ pub fn a_priori_scale(
 /// factor above 1 that lies in the patch's box is projected onto the patch, and the corners
 /// of the face it lands on (within that face's longest edge, else it belongs to another part
 /// of the surface) take at least its factor. Returns one factor per patch vertex (≥ 1).
-pub fn patch_vertex_factors(
-    field: &MetricField,
-    scale: &[f64],
-    patch: &TriMesh,
-) -> Vec<f64> {
+pub fn patch_vertex_factors(field: &MetricField, scale: &[f64], patch: &TriMesh) -> Vec<f64> {
     let mut out = vec![1.0f64; patch.n_vertices()];
     let Some((lo, hi)) = bbox(&patch.positions) else {
         return out;
@@ -433,7 +432,10 @@ mod tests {
         let mut m = generators::disk(0.5, 8, 24);
         let c = (0..m.n_vertices())
             .min_by(|&a, &b| {
-                m.positions[a].coords.norm().total_cmp(&m.positions[b].coords.norm())
+                m.positions[a]
+                    .coords
+                    .norm()
+                    .total_cmp(&m.positions[b].coords.norm())
             })
             .expect("vertices");
         m.positions[c].z = height;
@@ -505,11 +507,19 @@ mod tests {
         let fixed: Vec<bool> = (0..unit.n_vertices())
             .map(|v| boundary.contains(&VertexId::new(v)))
             .collect();
-        let tris: Vec<[u32; 3]> = unit.triangles.iter().map(|t| [t[0].0, t[1].0, t[2].0]).collect();
+        let tris: Vec<[u32; 3]> = unit
+            .triangles
+            .iter()
+            .map(|t| [t[0].0, t[1].0, t[2].0])
+            .collect();
         let same = deviations(
             &f,
             &normals,
-            &LiftedPatch { positions: &unit.positions, fixed: &fixed, triangles: &tris },
+            &LiftedPatch {
+                positions: &unit.positions,
+                fixed: &fixed,
+                triangles: &tris,
+            },
             1e-9,
         );
         assert!(same.is_empty(), "{same:?}");
@@ -524,12 +534,19 @@ mod tests {
         let dev = deviations(
             &f,
             &normals,
-            &LiftedPatch { positions: &cut, fixed: &fixed, triangles: &tris },
+            &LiftedPatch {
+                positions: &cut,
+                fixed: &fixed,
+                triangles: &tris,
+            },
             0.01,
         );
         assert!(!dev.is_empty());
         let worst = dev.iter().map(|d| d.1).fold(0.0, f64::max);
-        assert!((worst - h).abs() < 1e-9 * h.max(1.0) || worst <= h, "worst {worst}, h {h}");
+        assert!(
+            (worst - h).abs() < 1e-9 * h.max(1.0) || worst <= h,
+            "worst {worst}, h {h}"
+        );
         assert!(worst > 0.5 * h, "worst {worst}, h {h}");
         // Every deviating triangle touches the apex's neighbourhood.
         for (t, _) in &dev {

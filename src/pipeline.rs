@@ -839,7 +839,7 @@ fn remesh_patch(
         times.lift += t0.elapsed().as_secs_f64();
 
         let eps = options.fidelity.max_deviation;
-        if !(eps > 0.0) || rounds >= options.fidelity.rounds {
+        if eps.is_nan() || eps <= 0.0 || rounds >= options.fidelity.rounds {
             break replacement;
         }
         let t0 = Instant::now();
