@@ -74,6 +74,19 @@ pub struct SdOptions {
     /// When the LSCM is not certified, start from the Tutte map onto the ellipse of the
     /// LSCM boundary before falling back to the circle [true].
     pub shaped_tutte_init: bool,
+    /// When the LSCM is not certified (its boundary overlaps itself), minimise the symmetric
+    /// Dirichlet energy from it for up to this many locally injective Newton steps (no
+    /// barrier, no certificate) and start from the result if it passes the exact
+    /// certificate [0: measured no help, see paper-notes]; 0 disables.
+    pub repair_iters: usize,
+    /// Active set of the collision bound: when the bound cuts the step below this fraction
+    /// of the wanted step, re-solve with the colliding vertices stiffened along the edge
+    /// normal [0: measured slower, see paper-notes]; 0 disables.
+    pub collision_active_below: f64,
+    /// Re-solves per iteration for the active set [2].
+    pub collision_rounds: usize,
+    /// Stiffness of an active pair relative to the mean Hessian diagonal [1e3].
+    pub collision_stiffness: f64,
 }
 
 impl Default for SdOptions {
@@ -90,6 +103,10 @@ impl Default for SdOptions {
             abs_twist: true,
             collision_bound: true,
             shaped_tutte_init: false,
+            repair_iters: 0,
+            collision_active_below: 0.0,
+            collision_rounds: 2,
+            collision_stiffness: 1e3,
         }
     }
 }
@@ -454,11 +471,24 @@ impl Problem<'_> {
 /// root counts when `p` then lies on the segment (with a small margin: over-counting only
 /// shortens the step). Broad phase: sort-and-sweep on x over the boxes swept in
 /// `[0, horizon]`, like the certificate's. The exact certificate stays the final judge.
+#[cfg(test)]
 fn max_collision_free_step(
     uv: &[Point2<f64>],
     dir: &[f64],
     boundary: &[VertexId],
     horizon: f64,
+) -> f64 {
+    collisions(uv, dir, boundary, horizon, &mut Vec::new())
+}
+
+/// [`max_collision_free_step`], also listing in `hits` every (vertex, edge start, edge end)
+/// triple (vertex indices) that meets within `horizon`.
+fn collisions(
+    uv: &[Point2<f64>],
+    dir: &[f64],
+    boundary: &[VertexId],
+    horizon: f64,
+    hits: &mut Vec<[usize; 3]>,
 ) -> f64 {
     let m = boundary.len();
     if m < 4 || horizon.is_nan() || horizon <= 0.0 {
@@ -489,7 +519,7 @@ fn max_collision_free_step(
     items.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
     let mut tmax = horizon;
     let mut active: Vec<usize> = Vec::new();
-    let test = |vi: usize, ei: usize, tmax: &mut f64| {
+    let mut test = |vi: usize, ei: usize, tmax: &mut f64| {
         if vi == ei || vi == (ei + 1) % m {
             return;
         }
@@ -501,18 +531,21 @@ fn max_collision_free_step(
         let c0 = e.perp(&w);
         let c1 = e.perp(&dw) + de.perp(&w);
         let c2 = de.perp(&dw);
-        let mut check = |s: f64| {
-            if s > 0.0 && s < *tmax {
+        let mut hit = false;
+        for s in quadratic_roots(c2, c1, c0) {
+            if s > 0.0 && s < horizon {
                 let (es, ws) = (e + de * s, w + dw * s);
                 let l2 = es.norm_squared();
                 let u = if l2 > 0.0 { es.dot(&ws) / l2 } else { 0.5 };
                 if (-1e-6..=1.0 + 1e-6).contains(&u) {
-                    *tmax = s;
+                    *tmax = tmax.min(s);
+                    hit = true;
                 }
             }
-        };
-        for r in quadratic_roots(c2, c1, c0) {
-            check(r);
+        }
+        if hit {
+            let b = |i: usize| boundary[i % m].idx();
+            hits.push([b(vi), b(ei), b(ei + 1)]);
         }
     };
     for k in 0..items.len() {
@@ -610,6 +643,34 @@ pub fn optimize_with_log(
     options: &SdOptions,
 ) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
     certify(disk, uv0, boundary)?;
+    newton(disk, boundary, uv0, options, true)
+}
+
+/// [`optimize_with_log`] without the global part: locally injective projected Newton (no
+/// barrier, no collision bound, no certificate; triangles stay float-positive). The result
+/// may overlap itself; it is what [`initial_map`] tries to repair an overlapping LSCM with.
+/// Errors: `NotCertified` if a triangle of `uv0` is not float-positive.
+pub fn optimize_locally_injective(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    uv0: &[Point2<f64>],
+    options: &SdOptions,
+) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
+    newton(disk, boundary, uv0, options, false)
+}
+
+/// Projected Newton on the symmetric Dirichlet energy. `certified`: the full method of the
+/// module docs (barrier, collision bound, every iterate certified); otherwise only locally
+/// injective (float-positive triangles via a finite energy; no barrier, no collision bound,
+/// no certificate) — the LSCM repair of [`initial_map`], whose result is certified by the
+/// caller before it is used.
+fn newton(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    uv0: &[Point2<f64>],
+    options: &SdOptions,
+    certified: bool,
+) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
     let n = disk.n_vertices();
     let frames = triangle_frames(disk);
     let total_area: f64 = frames.iter().map(|f| f.area).sum();
@@ -626,7 +687,11 @@ pub fn optimize_with_log(
         frames,
         boundary,
         total_area,
-        eps: options.barrier_distance * disk.mean_edge_length(),
+        eps: if certified {
+            options.barrier_distance * disk.mean_edge_length()
+        } else {
+            0.0
+        },
         barrier_w: options.barrier_weight / disk.n_faces() as f64,
     };
     let clock = std::time::Instant::now();
@@ -668,6 +733,11 @@ pub fn optimize_with_log(
     let mut vals = vec![0.0; pat.row_idx.len()];
     let mut grad = vec![0.0; dim];
     let mut energy = prob.energy(&uv);
+    if !certified && !energy.is_finite() {
+        return Err(ParamError::NotCertified(
+            "the start has a flipped or degenerate triangle".to_string(),
+        ));
+    }
     log.energies.push(energy);
     log.min_double_area
         .push(min_double_area(&uv, &disk.triangles));
@@ -684,63 +754,115 @@ pub fn optimize_with_log(
         let trace: f64 = (0..dim)
             .map(|v| vals[pat.diag_slots[v / 2][if v % 2 == 0 { 0 } else { 3 }] as usize])
             .sum();
-        let mut mu = 1e-8 * trace / dim as f64;
-        let mut sol = Mat::<f64>::zeros(dim, 1);
-        let mut factored = false;
-        for _ in 0..8 {
-            shifted.copy_from_slice(&vals);
-            for vv in 0..n {
-                shifted[pat.diag_slots[vv][0] as usize] += mu;
-                shifted[pat.diag_slots[vv][3] as usize] += mu;
-            }
-            let mat = SparseColMatRef::new(sym, &shifted);
-            log.factorizations += 1;
-            if let Ok(llt) = symbolic.factorize_numeric_llt::<f64>(
-                &mut l_values,
-                mat,
-                Side::Lower,
-                Default::default(),
-                Par::Seq,
-                MemStack::new(&mut mem),
-                Default::default(),
-            ) {
-                for i in 0..dim {
-                    sol[(i, 0)] = -grad[i];
+        let mean_diag = trace / dim as f64;
+        // Newton direction for the Hessian plus `kappa · n nᵀ` on the 2×2 blocks of the
+        // vertices of every listed (vertex, edge) pair, `n` the edge normal.
+        let mut solve = |pairs: &[[usize; 3]], log: &mut SdLog| -> Result<Vec<f64>, ParamError> {
+            let mut mu = 1e-8 * mean_diag;
+            let kappa = options.collision_stiffness * mean_diag;
+            for _ in 0..8 {
+                shifted.copy_from_slice(&vals);
+                for vv in 0..n {
+                    shifted[pat.diag_slots[vv][0] as usize] += mu;
+                    shifted[pat.diag_slots[vv][3] as usize] += mu;
                 }
-                llt.solve_in_place_with_conj(
-                    Conj::No,
-                    sol.as_mut(),
+                for &[p, a, b] in pairs {
+                    let e = uv[b] - uv[a];
+                    let l = e.norm();
+                    if l <= 0.0 {
+                        continue;
+                    }
+                    let nn = Vector2::new(-e.y, e.x) / l;
+                    for v in [p, a, b] {
+                        let s = &pat.diag_slots[v];
+                        shifted[s[0] as usize] += kappa * nn.x * nn.x;
+                        shifted[s[1] as usize] += kappa * nn.y * nn.x;
+                        shifted[s[2] as usize] += kappa * nn.x * nn.y;
+                        shifted[s[3] as usize] += kappa * nn.y * nn.y;
+                    }
+                }
+                let mat = SparseColMatRef::new(sym, &shifted);
+                log.factorizations += 1;
+                if let Ok(llt) = symbolic.factorize_numeric_llt::<f64>(
+                    &mut l_values,
+                    mat,
+                    Side::Lower,
+                    Default::default(),
                     Par::Seq,
                     MemStack::new(&mut mem),
-                );
-                factored = true;
-                break;
+                    Default::default(),
+                ) {
+                    let mut sol = Mat::<f64>::zeros(dim, 1);
+                    for i in 0..dim {
+                        sol[(i, 0)] = -grad[i];
+                    }
+                    llt.solve_in_place_with_conj(
+                        Conj::No,
+                        sol.as_mut(),
+                        Par::Seq,
+                        MemStack::new(&mut mem),
+                    );
+                    return Ok((0..dim).map(|i| sol[(i, 0)]).collect());
+                }
+                mu *= 100.0;
             }
-            mu *= 100.0;
-        }
-        if !factored {
-            return Err(ParamError::Solver(
+            Err(ParamError::Solver(
                 "Newton Hessian is not positive definite".to_string(),
-            ));
-        }
-        let dir: Vec<f64> = (0..dim).map(|i| sol[(i, 0)]).collect();
-        let slope: f64 = dir.iter().zip(&grad).map(|(d, g)| d * g).sum();
+            ))
+        };
+        let mut dir = solve(&[], &mut log)?;
+        let mut slope: f64 = dir.iter().zip(&grad).map(|(d, g)| d * g).sum();
         log.time_ms[2] += lap();
         // NaN-safe: a NaN slope also means no usable descent direction.
         if slope.is_nan() || slope >= 0.0 {
             converged = true; // no descent direction left
             break;
         }
-        let t_flip = prob.max_flip_free_step(&uv, &dir);
-        let t_safe = options.step_fraction * t_flip;
+        let mut t_flip = prob.max_flip_free_step(&uv, &dir);
         // Boundary-collision bound over the steps the first trial can reach (the
         // extrapolation beyond it is judged by the certificate alone).
-        let horizon = t_flip.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
-        let t_coll = if options.collision_bound {
-            max_collision_free_step(&uv, &dir, boundary, horizon)
-        } else {
-            horizon
-        };
+        let mut horizon = t_flip.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
+        let mut t_coll = horizon;
+        if options.collision_bound && certified {
+            let mut pairs = Vec::new();
+            t_coll = collisions(&uv, &dir, boundary, horizon, &mut pairs);
+            // Active set: the step is cut short by boundary vertices about to hit boundary
+            // edges; stiffen the Hessian against their motion along the edge normal (a PSD
+            // term, so the new direction is still a descent direction) and re-solve, so that
+            // one colliding pair no longer shortens the step of the whole map.
+            let mut rounds = 0;
+            while t_coll < options.collision_active_below * horizon
+                && rounds < options.collision_rounds
+            {
+                rounds += 1;
+                let d2 = solve(&pairs, &mut log)?;
+                let s2: f64 = d2.iter().zip(&grad).map(|(d, g)| d * g).sum();
+                if s2.is_nan() || s2 >= 0.0 {
+                    break;
+                }
+                let f2 = prob.max_flip_free_step(&uv, &d2);
+                let h2 = f2.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
+                let mut more = Vec::new();
+                let c2 = collisions(&uv, &d2, boundary, h2, &mut more);
+                // Keep the new direction only if it predicts more decrease within its bound.
+                let gain = |s: f64, t: f64| -s * t.min(1.0);
+                if gain(s2, c2) <= gain(slope, t_coll) {
+                    break;
+                }
+                dir = d2;
+                slope = s2;
+                t_flip = f2;
+                horizon = h2;
+                t_coll = c2;
+                for p in more {
+                    if !pairs.contains(&p) {
+                        pairs.push(p);
+                    }
+                }
+            }
+            log.time_ms[2] += lap();
+        }
+        let t_safe = options.step_fraction * t_flip;
         if t_coll < horizon {
             log.collision_limited += 1;
         }
@@ -752,7 +874,7 @@ pub fn optimize_with_log(
             }
             let e = prob.energy(&trial);
             if e <= energy + options.armijo * t * slope {
-                if recertify(disk, &trial, boundary).is_ok() {
+                if !certified || recertify(disk, &trial, boundary).is_ok() {
                     accepted = Some(e);
                     break;
                 }
@@ -775,7 +897,10 @@ pub fn optimize_with_log(
                     );
                 }
                 let e = prob.energy(&probe);
-                if e.is_nan() || e >= e_best || recertify(disk, &probe, boundary).is_err() {
+                if e.is_nan()
+                    || e >= e_best
+                    || (certified && recertify(disk, &probe, boundary).is_err())
+                {
                     break;
                 }
                 e_best = e;
@@ -822,6 +947,9 @@ pub fn optimize_with_log(
 pub enum InitialMap {
     /// The free-boundary LSCM passed the certificate.
     Lscm,
+    /// The overlapping LSCM after locally injective symmetric Dirichlet steps
+    /// (`repair_iters`) removed the overlap.
+    RepairedLscm,
     /// Tutte map onto the ellipse of the (overlapping) LSCM boundary.
     EllipseTutte,
     /// Tutte map onto a circle (the certified fallback).
@@ -842,6 +970,18 @@ pub fn initial_map(
             scale_to_area(disk, &mut uv);
             if certify(disk, &uv, boundary).is_ok() {
                 return Ok((uv, InitialMap::Lscm));
+            }
+            if options.repair_iters > 0 {
+                let o = SdOptions {
+                    max_iters: options.repair_iters,
+                    ..*options
+                };
+                if let Ok((mut r, _)) = newton(disk, boundary, &uv, &o, false) {
+                    scale_to_area(disk, &mut r);
+                    if certify(disk, &r, boundary).is_ok() {
+                        return Ok((r, InitialMap::RepairedLscm));
+                    }
+                }
             }
             if options.shaped_tutte_init {
                 if let Some(shape) = super::ellipse_boundary(disk, boundary, &uv) {
