@@ -78,10 +78,16 @@ fn main() {
             if std::env::var("REPAIR").is_ok() {
                 if let Ok(mut l) = conemesh::param::lscm(&pm.mesh, &pm.boundary) {
                     scale_to_area(&pm.mesh, &mut l);
-                    let o = SdOptions {
+                    let mut o = SdOptions {
                         max_iters: env_usize("MI").unwrap_or(100),
                         ..Default::default()
                     };
+                    if let Ok(x) = std::env::var("RW") {
+                        o.repair_weight = x.parse().unwrap_or(0.0);
+                    }
+                    if let Ok(x) = std::env::var("RM") {
+                        o.repair_margin = x.parse().unwrap_or(0.1);
+                    }
                     match conemesh::param::optimize_locally_injective(
                         &pm.mesh,
                         &pm.boundary,

@@ -79,6 +79,11 @@ pub struct SdOptions {
     /// barrier, no certificate) and start from the result if it passes the exact
     /// certificate [0: measured no help, see paper-notes]; 0 disables.
     pub repair_iters: usize,
+    /// Weight of one overlap-repair term relative to one average triangle's energy share
+    /// (0: plain locally injective steps) [100].
+    pub repair_weight: f64,
+    /// Clearance the overlap repair aims for, as a fraction of the mean 3D edge length [0.1].
+    pub repair_margin: f64,
     /// Active set of the collision bound: when the bound cuts the step below this fraction
     /// of the wanted step, re-solve with the colliding vertices stiffened along the edge
     /// normal [0: measured slower, see paper-notes]; 0 disables.
@@ -103,7 +108,9 @@ impl Default for SdOptions {
             abs_twist: true,
             collision_bound: true,
             shaped_tutte_init: false,
-            repair_iters: 0,
+            repair_iters: 20,
+            repair_weight: 100.0,
+            repair_margin: 0.1,
             collision_active_below: 0.0,
             collision_rounds: 2,
             collision_stiffness: 1e3,
@@ -323,6 +330,106 @@ fn barrier_pairs(
     out
 }
 
+/// Boundary vertices (loop indices) that lie inside the image of another part of the disk:
+/// a point a hair (`delta`) outside the vertex, along the bisector of its exterior angle,
+/// has a non-zero winding number with respect to the boundary polygon (it would be 0 for a
+/// simple counter-clockwise boundary). Float arithmetic: this only steers the overlap
+/// repair; the exact certificate judges its result.
+fn penetrating_vertices(uv: &[Point2<f64>], boundary: &[VertexId], delta: f64) -> Vec<usize> {
+    let m = boundary.len();
+    let at = |i: usize| uv[boundary[i % m].idx()];
+    // Edges sorted by their lower y, for the +x ray casts.
+    let mut edges: Vec<(f64, f64, usize)> = (0..m)
+        .map(|i| {
+            let (a, b) = (at(i), at(i + 1));
+            (a.y.min(b.y), a.y.max(b.y), i)
+        })
+        .collect();
+    edges.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    let mut out = Vec::new();
+    for k in 0..m {
+        let p = at(k);
+        let (u1, u2) = (at(k + m - 1) - p, at(k + 1) - p);
+        let (l1, l2) = (u1.norm(), u2.norm());
+        if l1 <= 0.0 || l2 <= 0.0 {
+            continue;
+        }
+        let (u1, u2) = (u1 / l1, u2 / l2);
+        // The material lies counter-clockwise from u2 to u1, the exterior from u1 to u2.
+        let mut ext = u1.perp(&u2).atan2(u1.dot(&u2));
+        if ext <= 0.0 {
+            ext += std::f64::consts::TAU;
+        }
+        let (c, s) = ((0.5 * ext).cos(), (0.5 * ext).sin());
+        let q = p + Vector2::new(c * u1.x - s * u1.y, s * u1.x + c * u1.y) * delta;
+        let mut winding = 0i32;
+        let end = edges.partition_point(|e| e.0 <= q.y);
+        for &(y0, y1, i) in &edges[..end] {
+            if y1 <= q.y && y0 <= q.y && !(y0 <= q.y && q.y < y1) {
+                continue;
+            }
+            let (a, b) = (at(i), at(i + 1));
+            // Half-open rule on y; count crossings of the ray x > q.x with sign.
+            if (a.y <= q.y) != (b.y <= q.y) {
+                let x = a.x + (q.y - a.y) * (b.x - a.x) / (b.y - a.y);
+                if x > q.x {
+                    winding += if b.y > a.y { 1 } else { -1 };
+                }
+            }
+        }
+        if winding != 0 {
+            out.push(k);
+        }
+    }
+    out
+}
+
+/// For a penetrating boundary vertex (loop index `k`), the boundary edge it has to leave:
+/// the nearest edge not within two steps along the loop that has `p` on its inner (left)
+/// side. Returns the edge's loop index.
+fn edge_to_leave(uv: &[Point2<f64>], boundary: &[VertexId], k: usize) -> Option<usize> {
+    let m = boundary.len();
+    let at = |i: usize| uv[boundary[i % m].idx()];
+    let p = at(k);
+    let mut best: Option<(f64, usize)> = None;
+    for e in 0..m {
+        let gap = (k + m - e) % m;
+        if gap <= 2 || gap >= m - 1 {
+            continue;
+        }
+        let (a, b) = (at(e), at(e + 1));
+        let ab = b - a;
+        let l2 = ab.norm_squared();
+        if l2 <= 0.0 || ab.perp(&(p - a)) <= 0.0 {
+            continue;
+        }
+        let u = ((p - a).dot(&ab) / l2).clamp(0.0, 1.0);
+        let d = (p - (a + ab * u)).norm_squared();
+        if best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, e));
+        }
+    }
+    best.map(|(_, e)| e)
+}
+
+/// Signed distance of `uv[p]` from the line of `ab`, positive on the inner (left) side, with
+/// the inner unit normal and the clamped projection parameter along `ab`.
+fn signed_gap(
+    uv: &[Point2<f64>],
+    p: usize,
+    a: usize,
+    b: usize,
+) -> Option<(f64, (Vector2<f64>, f64))> {
+    let ab = uv[b] - uv[a];
+    let l = ab.norm();
+    if l <= 0.0 {
+        return None;
+    }
+    let nl = Vector2::new(-ab.y, ab.x) / l;
+    let w = uv[p] - uv[a];
+    Some((w.dot(&nl), (nl, (w.dot(&ab) / (l * l)).clamp(0.0, 1.0))))
+}
+
 /// The optimisation problem: rest frames, pattern, scales.
 struct Problem<'a> {
     tris: &'a [[VertexId; 3]],
@@ -331,6 +438,11 @@ struct Problem<'a> {
     total_area: f64,
     eps: f64,
     barrier_w: f64,
+    /// Overlap repair: weight (0 = off), clearance, and the (vertex, edge start, edge end)
+    /// pairs found by [`penetrating_vertices`] so far.
+    pen_w: f64,
+    pen_margin: f64,
+    pen_pairs: Vec<[usize; 3]>,
 }
 
 impl Problem<'_> {
@@ -354,6 +466,14 @@ impl Problem<'_> {
                 return f64::INFINITY;
             }
             e += self.barrier_w * (self.eps / d - 1.0).powi(2);
+        }
+        for &[p, a, b] in &self.pen_pairs {
+            if let Some((sd, _)) = signed_gap(uv, p, a, b) {
+                let x = (sd + self.pen_margin) / self.pen_margin;
+                if x > 0.0 {
+                    e += self.pen_w * x * x;
+                }
+            }
         }
         e
     }
@@ -438,6 +558,29 @@ impl Problem<'_> {
                 vals[s[1] as usize] += d2 * gv.y * gv.x;
                 vals[s[2] as usize] += d2 * gv.x * gv.y;
                 vals[s[3] as usize] += d2 * gv.y * gv.y;
+            }
+        }
+        // Overlap repair: w ((s + margin) / margin)² while positive, s the signed distance of
+        // p inside the line of ab; gradient along the edge's inner normal (p moves out, a and b
+        // by their share), Gauss–Newton diagonal blocks.
+        let k = self.pen_w / (self.pen_margin * self.pen_margin);
+        for &[p, a, b] in &self.pen_pairs {
+            let Some((sd, (nl, u))) = signed_gap(uv, p, a, b) else {
+                continue;
+            };
+            if sd + self.pen_margin <= 0.0 {
+                continue;
+            }
+            let d1 = 2.0 * k * (sd + self.pen_margin);
+            for (v, c) in [(p, 1.0), (a, -(1.0 - u)), (b, -u)] {
+                grad[2 * v] += d1 * c * nl.x;
+                grad[2 * v + 1] += d1 * c * nl.y;
+                let h = 2.0 * k * c * c;
+                let s = &pat.diag_slots[v];
+                vals[s[0] as usize] += h * nl.x * nl.x;
+                vals[s[1] as usize] += h * nl.y * nl.x;
+                vals[s[2] as usize] += h * nl.x * nl.y;
+                vals[s[3] as usize] += h * nl.y * nl.y;
             }
         }
         Ok(())
@@ -631,6 +774,26 @@ fn min_double_area(uv: &[Point2<f64>], tris: &[[VertexId; 3]]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Add a repair pair for every boundary vertex of `uv` that now penetrates another part of
+/// the disk (and has none yet). Returns whether any was added.
+fn add_penetrations(uv: &[Point2<f64>], boundary: &[VertexId], prob: &mut Problem) -> bool {
+    let delta = 1e-3 * prob.pen_margin;
+    let mut added = false;
+    for k in penetrating_vertices(uv, boundary, delta) {
+        let p = boundary[k].idx();
+        if prob.pen_pairs.iter().any(|q| q[0] == p) {
+            continue;
+        }
+        if let Some(e) = edge_to_leave(uv, boundary, k) {
+            let m = boundary.len();
+            prob.pen_pairs
+                .push([p, boundary[e].idx(), boundary[(e + 1) % m].idx()]);
+            added = true;
+        }
+    }
+    added
+}
+
 /// Minimise the symmetric Dirichlet energy of the certified map `uv0` of `disk` (free
 /// boundary, projected Newton, boundary barrier, certified line search; see the module
 /// docs). Returns the last accepted iterate, which passes `certify_bijective`, and the log.
@@ -682,7 +845,7 @@ fn newton(
             .push(min_double_area(&uv, &disk.triangles));
         return Ok((uv, log));
     }
-    let prob = Problem {
+    let mut prob = Problem {
         tris: &disk.triangles,
         frames,
         boundary,
@@ -693,6 +856,13 @@ fn newton(
             0.0
         },
         barrier_w: options.barrier_weight / disk.n_faces() as f64,
+        pen_w: if certified {
+            0.0
+        } else {
+            options.repair_weight / disk.n_faces() as f64
+        },
+        pen_margin: options.repair_margin * disk.mean_edge_length(),
+        pen_pairs: Vec::new(),
     };
     let clock = std::time::Instant::now();
     let mut lap = {
@@ -732,6 +902,9 @@ fn newton(
     log.time_ms[0] += lap();
     let mut vals = vec![0.0; pat.row_idx.len()];
     let mut grad = vec![0.0; dim];
+    if prob.pen_w > 0.0 {
+        add_penetrations(&uv, boundary, &mut prob);
+    }
     let mut energy = prob.energy(&uv);
     if !certified && !energy.is_finite() {
         return Err(ParamError::NotCertified(
@@ -933,6 +1106,21 @@ fn newton(
         // relative to E itself the constant 4 would stop developable patches early.
         let rel = (energy - e_new) / (energy - 4.0).max(f64::MIN_POSITIVE);
         energy = e_new;
+        if !certified && prob.pen_w > 0.0 {
+            // Overlap repair: done once the map is certified with every repaired vertex at
+            // least half the clearance outside; else add the newly penetrating vertices.
+            let clear = prob.pen_pairs.iter().all(|&[p, a, b]| {
+                signed_gap(&uv, p, a, b).is_none_or(|(sd, _)| sd <= -0.5 * prob.pen_margin)
+            });
+            if clear && recertify(disk, &uv, boundary).is_ok() {
+                converged = true;
+                break;
+            }
+            if add_penetrations(&uv, boundary, &mut prob) {
+                energy = prob.energy(&uv);
+                continue;
+            }
+        }
         if rel < options.rel_tol {
             converged = true;
             break;
