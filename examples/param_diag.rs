@@ -203,10 +203,13 @@ fn main() {
             }
             // INIT=1: the parameterizer's own initial map (INIT=0: without the ellipse Tutte).
             if let Ok(v) = std::env::var("INIT") {
-                let o = SdOptions {
+                let mut o = SdOptions {
                     shaped_tutte_init: v != "0",
                     ..Default::default()
                 };
+                if let Some(x) = env_usize("RI") {
+                    o.repair_iters = x;
+                }
                 match conemesh::param::initial_map(&pm.mesh, &pm.boundary, &o) {
                     Ok((u, kind)) => {
                         println!("  init {kind:?}");

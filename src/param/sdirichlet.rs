@@ -108,7 +108,7 @@ impl Default for SdOptions {
             abs_twist: true,
             collision_bound: true,
             shaped_tutte_init: false,
-            repair_iters: 20,
+            repair_iters: 10,
             repair_weight: 100.0,
             repair_margin: 0.1,
             collision_active_below: 0.0,
@@ -232,6 +232,9 @@ impl Pattern {
         }
     }
 }
+
+/// Overlap repair iterations without fewer crossing boundary edges before it gives up.
+const REPAIR_PATIENCE: usize = 3;
 
 /// Hessian dimension (2 × vertices) from which the supernodal Cholesky is forced.
 const SUPERNODAL_MIN_DIM: usize = 2000;
@@ -774,12 +777,73 @@ fn min_double_area(uv: &[Point2<f64>], tris: &[[VertexId; 3]]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Pairs of non-adjacent boundary edges (loop indices) whose segments cross or touch (float
+/// orientation tests; sort-and-sweep on x).
+fn crossing_edges(uv: &[Point2<f64>], boundary: &[VertexId]) -> Vec<(usize, usize)> {
+    let m = boundary.len();
+    let at = |i: usize| uv[boundary[i % m].idx()];
+    let mut items: Vec<(f64, f64, f64, f64, usize)> = (0..m)
+        .map(|i| {
+            let (a, b) = (at(i), at(i + 1));
+            (a.x.min(b.x), a.x.max(b.x), a.y.min(b.y), a.y.max(b.y), i)
+        })
+        .collect();
+    items.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    let orient = |a: Point2<f64>, b: Point2<f64>, c: Point2<f64>| (b - a).perp(&(c - a));
+    let mut out = Vec::new();
+    let mut active: Vec<usize> = Vec::new();
+    for k in 0..items.len() {
+        let (x0, _, y0, y1, i) = items[k];
+        active.retain(|&j| items[j].1 >= x0);
+        for &j in &active {
+            let (_, _, yj0, yj1, e) = items[j];
+            if yj1 < y0 || yj0 > y1 || (i + 1) % m == e || (e + 1) % m == i {
+                continue;
+            }
+            let (a, b, c, d) = (at(i), at(i + 1), at(e), at(e + 1));
+            let (o1, o2) = (orient(a, b, c), orient(a, b, d));
+            let (o3, o4) = (orient(c, d, a), orient(c, d, b));
+            if o1 * o2 <= 0.0 && o3 * o4 <= 0.0 {
+                out.push((i, e));
+            }
+        }
+        active.push(k);
+    }
+    out
+}
+
 /// Add a repair pair for every boundary vertex of `uv` that now penetrates another part of
-/// the disk (and has none yet). Returns whether any was added.
+/// the disk (and has none yet), and for the endpoints of crossing boundary edges that lie
+/// on the inner side of the other edge. Returns whether any was added.
 fn add_penetrations(uv: &[Point2<f64>], boundary: &[VertexId], prob: &mut Problem) -> bool {
     let delta = 1e-3 * prob.pen_margin;
+    let m = boundary.len();
     let mut added = false;
-    for k in penetrating_vertices(uv, boundary, delta) {
+    let inside = penetrating_vertices(uv, boundary, delta);
+    for (e1, e2) in crossing_edges(uv, boundary) {
+        // Crossings with a penetrating endpoint are repaired through that vertex below; the
+        // rest are thin spikes crossing each other (no vertex inside the other's material).
+        if [e1, (e1 + 1) % m, e2, (e2 + 1) % m]
+            .iter()
+            .any(|k| inside.contains(k))
+        {
+            continue;
+        }
+        for (e, f) in [(e1, e2), (e2, e1)] {
+            let (a, b) = (boundary[f].idx(), boundary[(f + 1) % m].idx());
+            for k in [e, (e + 1) % m] {
+                let p = boundary[k].idx();
+                let pair = [p, a, b];
+                if signed_gap(uv, p, a, b).is_some_and(|(sd, _)| sd > 0.0)
+                    && !prob.pen_pairs.contains(&pair)
+                {
+                    prob.pen_pairs.push(pair);
+                    added = true;
+                }
+            }
+        }
+    }
+    for k in inside {
         let p = boundary[k].idx();
         if prob.pen_pairs.iter().any(|q| q[0] == p) {
             continue;
@@ -918,6 +982,7 @@ fn newton(
     let mut abs_twist = false;
     let mut trial = uv.clone();
     let mut probe = uv.clone();
+    let (mut fewest_crossings, mut stalled) = (usize::MAX, 0);
     while log.iterations < options.max_iters {
         lap();
         prob.assemble(&uv, &pat, &mut grad, &mut vals, abs_twist)?;
@@ -1115,6 +1180,18 @@ fn newton(
             if clear && recertify(disk, &uv, boundary).is_ok() {
                 converged = true;
                 break;
+            }
+            // Give up early when the number of crossing boundary edges stops falling: the
+            // caller then starts from the Tutte map, and every repair step is time lost.
+            let crossings = crossing_edges(&uv, boundary).len();
+            if crossings < fewest_crossings {
+                fewest_crossings = crossings;
+                stalled = 0;
+            } else {
+                stalled += 1;
+                if stalled >= REPAIR_PATIENCE {
+                    break;
+                }
             }
             if add_penetrations(&uv, boundary, &mut prob) {
                 energy = prob.energy(&uv);
