@@ -210,6 +210,12 @@ fn main() {
                 if let Some(x) = env_usize("RI") {
                     o.repair_iters = x;
                 }
+                if let Ok(x) = std::env::var("RW") {
+                    o.repair_weight = x.parse().unwrap_or(100.0);
+                }
+                if let Ok(x) = std::env::var("RM") {
+                    o.repair_margin = x.parse().unwrap_or(0.1);
+                }
                 match conemesh::param::initial_map(&pm.mesh, &pm.boundary, &o) {
                     Ok((u, kind)) => {
                         println!("  init {kind:?}");

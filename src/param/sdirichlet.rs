@@ -14,6 +14,9 @@
 //!   (zero exactly when `p` touches the edge) enters `(ε/d − 1)²` while `d < ε`, with `ε`
 //!   a fraction of the mean edge length. Its Hessian is the Gauss–Newton term, kept on the
 //!   2×2 diagonal blocks so the sparsity pattern does not change.
+//! * Start: the free-boundary LSCM when certified; else the LSCM after the overlap repair
+//!   (`repair_iters`) when that is certified; else the Tutte map. The repair steps are part
+//!   of computing the start: only the certified start and the iterates after it count.
 //! * Line search: the largest flip-free step (smallest positive root of `det J(t) = 0` over
 //!   all triangles) times `step_fraction`, then Armijo backtracking; a trial is accepted only
 //!   if `certify_bijective` (exact) passes, so every iterate is certified.
@@ -74,15 +77,18 @@ pub struct SdOptions {
     /// When the LSCM is not certified, start from the Tutte map onto the ellipse of the
     /// LSCM boundary before falling back to the circle [true].
     pub shaped_tutte_init: bool,
-    /// When the LSCM is not certified (its boundary overlaps itself), minimise the symmetric
-    /// Dirichlet energy from it for up to this many locally injective Newton steps (no
-    /// barrier, no certificate) and start from the result if it passes the exact
-    /// certificate [0: measured no help, see paper-notes]; 0 disables.
+    /// Overlap repair of an LSCM that is not certified (its boundary overlaps itself, mostly
+    /// where narrow slits of a ragged cover patch close): up to this many locally injective
+    /// Newton steps from it on the symmetric Dirichlet energy plus a penalty pushing every
+    /// penetrating boundary vertex `repair_margin` back out of the edge it crossed (no
+    /// barrier, no certificate during the steps; stops early once certified, or when the
+    /// number of crossing boundary edges has not fallen for 6 steps). The result is used
+    /// only if it passes the exact certificate, else the Tutte map [30]; 0 disables.
     pub repair_iters: usize,
     /// Weight of one overlap-repair term relative to one average triangle's energy share
     /// (0: plain locally injective steps) [100].
     pub repair_weight: f64,
-    /// Clearance the overlap repair aims for, as a fraction of the mean 3D edge length [0.1].
+    /// Clearance the overlap repair aims for, as a fraction of the mean 3D edge length [0.2].
     pub repair_margin: f64,
     /// Active set of the collision bound: when the bound cuts the step below this fraction
     /// of the wanted step, re-solve with the colliding vertices stiffened along the edge
@@ -108,9 +114,9 @@ impl Default for SdOptions {
             abs_twist: true,
             collision_bound: true,
             shaped_tutte_init: false,
-            repair_iters: 10,
+            repair_iters: 30,
             repair_weight: 100.0,
-            repair_margin: 0.1,
+            repair_margin: 0.2,
             collision_active_below: 0.0,
             collision_rounds: 2,
             collision_stiffness: 1e3,
@@ -234,7 +240,7 @@ impl Pattern {
 }
 
 /// Overlap repair iterations without fewer crossing boundary edges before it gives up.
-const REPAIR_PATIENCE: usize = 3;
+const REPAIR_PATIENCE: usize = 6;
 
 /// Hessian dimension (2 × vertices) from which the supernodal Cholesky is forced.
 const SUPERNODAL_MIN_DIM: usize = 2000;
@@ -874,8 +880,9 @@ pub fn optimize_with_log(
 }
 
 /// [`optimize_with_log`] without the global part: locally injective projected Newton (no
-/// barrier, no collision bound, no certificate; triangles stay float-positive). The result
-/// may overlap itself; it is what [`initial_map`] tries to repair an overlapping LSCM with.
+/// barrier, no collision bound, no certificate; triangles stay float-positive), with the
+/// overlap-repair penalty when `options.repair_weight > 0` (see `SdOptions::repair_iters`;
+/// then it stops once the map is certified). The result may still overlap itself.
 /// Errors: `NotCertified` if a triangle of `uv0` is not float-positive.
 pub fn optimize_locally_injective(
     disk: &TriMesh,
@@ -1061,6 +1068,7 @@ fn newton(
         // extrapolation beyond it is judged by the certificate alone).
         let mut horizon = t_flip.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
         let mut t_coll = horizon;
+        // Not in the overlap repair: resolving an overlap moves vertices across edges.
         if options.collision_bound && certified {
             let mut pairs = Vec::new();
             t_coll = collisions(&uv, &dir, boundary, horizon, &mut pairs);
@@ -1212,8 +1220,8 @@ fn newton(
 pub enum InitialMap {
     /// The free-boundary LSCM passed the certificate.
     Lscm,
-    /// The overlapping LSCM after locally injective symmetric Dirichlet steps
-    /// (`repair_iters`) removed the overlap.
+    /// The overlapping LSCM after the overlap repair (`repair_iters`: locally injective
+    /// symmetric Dirichlet steps with a penetration penalty) passed the certificate.
     RepairedLscm,
     /// Tutte map onto the ellipse of the (overlapping) LSCM boundary.
     EllipseTutte,
@@ -1222,7 +1230,8 @@ pub enum InitialMap {
 }
 
 /// The certified initial map of [`SymmetricDirichlet`], scaled to the 3D area: the LSCM if
-/// it passes the exact certificate; else (`shaped_tutte_init`) the Tutte map onto the
+/// it passes the exact certificate; else (`repair_iters > 0`) the repaired LSCM if it
+/// passes; else (`shaped_tutte_init`) the Tutte map onto the
 /// ellipse of the LSCM boundary ([`super::ellipse_boundary`], strictly convex, so Tutte's
 /// theorem applies) if it passes; else the circle Tutte map (`init_weights`, then uniform).
 pub fn initial_map(
