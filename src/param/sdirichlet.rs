@@ -1434,6 +1434,41 @@ mod tests {
     }
 
     #[test]
+    fn overlap_detection_finds_the_vertex_pushed_into_the_other_arm() {
+        // A "U" (counter-clockwise): arms x ∈ [0, 1] and x ∈ [2, 3] above y = 1.
+        let mut uv = vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(3.0, 0.0),
+            Point2::new(3.0, 3.0),
+            Point2::new(2.0, 3.0),
+            Point2::new(2.0, 1.0),
+            Point2::new(1.0, 1.0),
+            Point2::new(1.0, 3.0),
+            Point2::new(0.0, 3.0),
+        ];
+        let boundary: Vec<VertexId> = (0..8).map(VertexId::new).collect();
+        assert!(penetrating_vertices(&uv, &boundary, 1e-6).is_empty());
+        assert!(crossing_edges(&uv, &boundary).is_empty());
+        // The right arm's top-left corner pushed across the slit into the left arm.
+        uv[3] = Point2::new(0.5, 2.5);
+        let inside = penetrating_vertices(&uv, &boundary, 1e-6);
+        assert!(inside.contains(&3), "{inside:?}");
+        assert!(!inside.contains(&0) && !inside.contains(&1), "{inside:?}");
+        let mut crossings: Vec<(usize, usize)> = crossing_edges(&uv, &boundary)
+            .into_iter()
+            .map(|(a, b)| (a.min(b), a.max(b)))
+            .collect();
+        crossings.sort_unstable();
+        assert_eq!(crossings, vec![(2, 5), (3, 5)]);
+        // The edge it has to leave is the left arm's inner side (5, 6), and the repair term
+        // pushes it back out: its signed gap is positive (inside) now.
+        assert_eq!(edge_to_leave(&uv, &boundary, 3), Some(5));
+        let (sd, (n, _)) = signed_gap(&uv, 3, 5, 6).unwrap();
+        assert!((sd - 0.5).abs() < 1e-12, "{sd}");
+        assert!((n - Vector2::new(-1.0, 0.0)).norm() < 1e-12, "{n}");
+    }
+
+    #[test]
     fn quadratic_roots() {
         assert_eq!(smallest_positive_root(1.0, -3.0, 2.0), Some(1.0));
         assert_eq!(smallest_positive_root(0.0, -2.0, 1.0), Some(0.5));
