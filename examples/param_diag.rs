@@ -52,6 +52,43 @@ fn main() {
             let Ok(pm) = extract_patch(&mesh, &p.faces) else {
                 continue;
             };
+            if let Some(reps) = env_usize("LSCMREPS") {
+                let mut best = f64::INFINITY;
+                for _ in 0..reps {
+                    let t = Instant::now();
+                    let _ = conemesh::param::lscm(&pm.mesh, &pm.boundary);
+                    best = best.min(t.elapsed().as_secs_f64() * 1e3);
+                }
+                println!(
+                    "{name} p{pi} {}f: lscm best of {reps} {best:.2} ms",
+                    p.faces.len()
+                );
+                continue;
+            }
+            // REPS=n: best-of-n wall time of the default parameterizer (initial map included).
+            if let Some(reps) = env_usize("REPS") {
+                use conemesh::param::Parameterizer;
+                let mut best = f64::INFINITY;
+                let mut rep = None;
+                for _ in 0..reps {
+                    let t = Instant::now();
+                    let r = conemesh::param::SymmetricDirichlet::default()
+                        .parameterize(&pm.mesh, &pm.boundary);
+                    best = best.min(t.elapsed().as_secs_f64() * 1e3);
+                    rep = r.ok().map(|p| p.report);
+                }
+                if let Some(r) = rep {
+                    println!(
+                        "{name} p{pi} {}f: best of {reps} {best:.1} ms, it {} budget {} meanc {:.4} maxc {:.3}",
+                        p.faces.len(),
+                        r.iterations,
+                        r.hit_budget,
+                        r.mean_conformal,
+                        r.max_conformal
+                    );
+                }
+                continue;
+            }
             let t0 = Instant::now();
             let circle = circle_boundary(&pm.mesh, &pm.boundary, 1.0);
             let Ok(mut uv0) = tutte_embedding(&pm.mesh, &pm.boundary, &circle, TutteWeights::Cotan)
@@ -76,7 +113,10 @@ fn main() {
                 }
             }
             if std::env::var("REPAIR").is_ok() {
-                if let Ok(mut l) = conemesh::param::lscm(&pm.mesh, &pm.boundary) {
+                let tl = Instant::now();
+                let l = conemesh::param::lscm(&pm.mesh, &pm.boundary);
+                println!("  lscm {:.1} ms", tl.elapsed().as_secs_f64() * 1e3);
+                if let Ok(mut l) = l {
                     scale_to_area(&pm.mesh, &mut l);
                     let mut o = SdOptions {
                         max_iters: env_usize("MI").unwrap_or(100),

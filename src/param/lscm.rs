@@ -9,9 +9,11 @@ use super::distortion::triangle_frames;
 use super::ParamError;
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
-use faer::linalg::solvers::Solve;
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Side};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
+use faer::{Conj, Mat, Par, Side};
 use nalgebra::Point2;
 
 /// LSCM of `disk`: minimises `Σ_t A_t ((a − d)² + (b + c)²)` over the Jacobians
@@ -102,10 +104,7 @@ pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, P
     }
     let a = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &trips)
         .map_err(|e| ParamError::Solver(format!("assembling LSCM: {e:?}")))?;
-    let sol = a
-        .sp_cholesky(Side::Lower)
-        .map_err(|e| ParamError::Solver(format!("LSCM Cholesky: {e:?}")))?
-        .solve(&rhs);
+    let sol = cholesky_solve(a.as_ref(), rhs)?;
     for v in 0..n {
         for c in 0..2 {
             let i = index[2 * v + c];
@@ -123,6 +122,43 @@ pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, P
         )));
     }
     Ok(uv)
+}
+
+/// Solve `a x = rhs` (symmetric positive definite, full storage) by sparse Cholesky; the
+/// supernodal kernel is forced from the size where it wins for the 2D-mesh matrices of
+/// Sec. 3.3 (as for the Newton Hessian, `super::sdirichlet`).
+fn cholesky_solve(
+    a: SparseColMatRef<'_, usize, f64>,
+    mut rhs: Mat<f64>,
+) -> Result<Mat<f64>, ParamError> {
+    let err =
+        |what: &str, e: &dyn std::fmt::Debug| ParamError::Solver(format!("LSCM {what}: {e:?}"));
+    let mut params = CholeskySymbolicParams::default();
+    if a.nrows() >= super::sdirichlet::SUPERNODAL_MIN_DIM {
+        params.supernodal_flop_ratio_threshold = SupernodalThreshold::FORCE_SUPERNODAL;
+    }
+    let symbolic =
+        factorize_symbolic_cholesky(a.symbolic(), Side::Lower, Default::default(), params)
+            .map_err(|e| err("symbolic Cholesky", &e))?;
+    let mut l_values = vec![0.0; symbolic.len_val()];
+    let mut mem = MemBuffer::new(
+        symbolic
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+    );
+    let llt = symbolic
+        .factorize_numeric_llt::<f64>(
+            &mut l_values,
+            a,
+            Side::Lower,
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .map_err(|e| err("Cholesky", &e))?;
+    llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), Par::Seq, MemStack::new(&mut mem));
+    Ok(rhs)
 }
 
 #[cfg(test)]

@@ -243,7 +243,7 @@ impl Pattern {
 const REPAIR_PATIENCE: usize = 6;
 
 /// Hessian dimension (2 × vertices) from which the supernodal Cholesky is forced.
-const SUPERNODAL_MIN_DIM: usize = 2000;
+pub(super) const SUPERNODAL_MIN_DIM: usize = 2000;
 
 /// Energy, gradient and projected Hessian of one triangle with respect to `vec(F)`
 /// (row-major `a, b, c, d`). `None` when `det F ≤ 0` (infinite energy).
