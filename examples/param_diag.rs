@@ -72,8 +72,11 @@ fn main() {
                 let mut rep = None;
                 for _ in 0..reps {
                     let t = Instant::now();
-                    let r = conemesh::param::SymmetricDirichlet::default()
-                        .parameterize(&pm.mesh, &pm.boundary);
+                    let mut sd = conemesh::param::SymmetricDirichlet::default();
+                    if let Some(x) = env_usize("RI") {
+                        sd.options.repair_iters = x;
+                    }
+                    let r = sd.parameterize(&pm.mesh, &pm.boundary);
                     best = best.min(t.elapsed().as_secs_f64() * 1e3);
                     rep = r.ok().map(|p| p.report);
                 }
