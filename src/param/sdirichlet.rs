@@ -288,6 +288,85 @@ impl Setup {
     }
 }
 
+/// [`super::lscm()`] through the shared Newton [`Setup`]: the LSCM normal matrix has the
+/// Hessian's pattern, so it is assembled into the pattern's slots (pinned dofs become
+/// identity rows) and factorised with the symbolic factorisation the optimisation reuses,
+/// instead of sorting triplets and ordering a second time. Same pins, same minimiser.
+fn lscm_shared(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    setup: &Setup,
+) -> Result<Vec<Point2<f64>>, ParamError> {
+    let (p0, p1, dist) = super::lscm::pins(disk, boundary)?;
+    let n = disk.n_vertices();
+    let dim = 2 * n;
+    let pat = &setup.pat;
+    let mut fixed = vec![None; dim];
+    fixed[2 * p0.idx()] = Some(0.0);
+    fixed[2 * p0.idx() + 1] = Some(0.0);
+    fixed[2 * p1.idx()] = Some(dist);
+    fixed[2 * p1.idx() + 1] = Some(0.0);
+    let mut vals = vec![0.0; pat.row_idx.len()];
+    let mut sol = Mat::<f64>::zeros(dim, 1);
+    for (ti, (t, fr)) in disk.triangles.iter().zip(triangle_frames(disk)).enumerate() {
+        if fr.area <= 0.0 {
+            continue;
+        }
+        let (r1, r2) = super::lscm::conformal_rows(&fr.grad);
+        let dof = |l: usize| 2 * t[l / 2].idx() + l % 2;
+        for l1 in 0..6 {
+            if fixed[dof(l1)].is_some() {
+                continue;
+            }
+            for l2 in 0..6 {
+                let w = fr.area * (r1[l1] * r1[l2] + r2[l1] * r2[l2]);
+                match fixed[dof(l2)] {
+                    Some(x) => sol[(dof(l1), 0)] -= w * x,
+                    None => vals[pat.tri_slots[ti][l1 * 6 + l2] as usize] += w,
+                }
+            }
+        }
+    }
+    for (d, x) in fixed.iter().enumerate() {
+        if let Some(x) = x {
+            vals[pat.diag_slots[d / 2][if d % 2 == 0 { 0 } else { 3 }] as usize] = 1.0;
+            sol[(d, 0)] = *x;
+        }
+    }
+    let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
+    let symbolic = &setup.symbolic;
+    let mut l_values = vec![0.0; symbolic.len_val()];
+    let mut mem = MemBuffer::new(
+        symbolic
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+    );
+    let llt = symbolic
+        .factorize_numeric_llt::<f64>(
+            &mut l_values,
+            SparseColMatRef::new(sym, &vals),
+            Side::Lower,
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .map_err(|e| ParamError::Solver(format!("LSCM Cholesky: {e:?}")))?;
+    llt.solve_in_place_with_conj(Conj::No, sol.as_mut(), Par::Seq, MemStack::new(&mut mem));
+    let uv: Vec<Point2<f64>> = (0..n)
+        .map(|v| Point2::new(sol[(2 * v, 0)], sol[(2 * v + 1, 0)]))
+        .collect();
+    if let Some(v) = uv
+        .iter()
+        .position(|p| !(p.x.is_finite() && p.y.is_finite()))
+    {
+        return Err(ParamError::Solver(format!(
+            "LSCM gave a non-finite position for v{v}"
+        )));
+    }
+    Ok(uv)
+}
+
 /// Energy, gradient and projected Hessian of one triangle with respect to `vec(F)`
 /// (row-major `a, b, c, d`). `None` when `det F ≤ 0` (infinite energy).
 #[inline]
@@ -1279,7 +1358,8 @@ fn initial_map_with(
     setup: &OnceCell<Setup>,
 ) -> Result<(Vec<Point2<f64>>, InitialMap), ParamError> {
     if options.free_boundary_init {
-        if let Ok(mut uv) = super::lscm(disk, boundary) {
+        let lscm = Setup::get(setup, disk).and_then(|s| lscm_shared(disk, boundary, s));
+        if let Ok(mut uv) = lscm {
             scale_to_area(disk, &mut uv);
             if certify(disk, &uv, boundary).is_ok() {
                 return Ok((uv, InitialMap::Lscm));
@@ -1507,6 +1587,24 @@ mod tests {
         let (sd, (n, _)) = signed_gap(&uv, 3, 5, 6).unwrap();
         assert!((sd - 0.5).abs() < 1e-12, "{sd}");
         assert!((n - Vector2::new(-1.0, 0.0)).norm() < 1e-12, "{n}");
+    }
+
+    #[test]
+    fn shared_lscm_equals_the_public_lscm() {
+        let mut disk = crate::mesh::generators::cylinder_piece(1.0, 2.0, 1.0, 8, 3);
+        // Bend it a little more so the map is not a plain unrolling.
+        for p in &mut disk.positions {
+            p.z += 0.1 * p.x * p.y;
+        }
+        let boundary = super::super::disk_boundary(&disk).unwrap();
+        let a = super::super::lscm(&disk, &boundary).unwrap();
+        let b = lscm_shared(&disk, &boundary, &Setup::new(&disk).unwrap()).unwrap();
+        let err = a
+            .iter()
+            .zip(&b)
+            .map(|(p, q)| (p - q).norm())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-9, "{err}");
     }
 
     #[test]
