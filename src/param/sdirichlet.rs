@@ -495,9 +495,9 @@ fn penetrating_vertices(uv: &[Point2<f64>], boundary: &[VertexId], delta: f64) -
         let q = p + Vector2::new(c * u1.x - s * u1.y, s * u1.x + c * u1.y) * delta;
         let mut winding = 0i32;
         let end = edges.partition_point(|e| e.0 <= q.y);
-        for &(y0, y1, i) in &edges[..end] {
-            if y1 <= q.y && y0 <= q.y && !(y0 <= q.y && q.y < y1) {
-                continue;
+        for &(_, y1, i) in &edges[..end] {
+            if y1 < q.y {
+                continue; // entirely below the ray
             }
             let (a, b) = (at(i), at(i + 1));
             // Half-open rule on y; count crossings of the ray x > q.x with sign.
@@ -1100,7 +1100,7 @@ fn newton(
     let (mut fewest_crossings, mut stalled) = (usize::MAX, 0);
     while log.iterations < options.max_iters {
         lap();
-        prob.assemble(&uv, &pat, &mut grad, &mut vals, abs_twist)?;
+        prob.assemble(&uv, pat, &mut grad, &mut vals, abs_twist)?;
         log.time_ms[1] += lap();
         // Regularise the projected Hessian (translations and, at an isometry, rotations are
         // in its null space); grow the shift until the Cholesky factorisation succeeds.
