@@ -156,8 +156,9 @@ fn main() {
                                 );
                             }
                             println!(
-                                "  repair: it {} E {:.4} maxc {:.3} meanc {:.4} ms {:.1} cert {:?}",
+                                "  repair: it {} split {:.1?} E {:.4} maxc {:.3} meanc {:.4} ms {:.1} cert {:?}",
                                 log.iterations,
+                                log.time_ms,
                                 log.energies.last().copied().unwrap_or(f64::NAN),
                                 r.max_conformal,
                                 r.mean_conformal,

@@ -469,14 +469,30 @@ fn barrier_pairs(
 fn penetrating_vertices(uv: &[Point2<f64>], boundary: &[VertexId], delta: f64) -> Vec<usize> {
     let m = boundary.len();
     let at = |i: usize| uv[boundary[i % m].idx()];
-    // Edges sorted by their lower y, for the +x ray casts.
-    let mut edges: Vec<(f64, f64, usize)> = (0..m)
-        .map(|i| {
-            let (a, b) = (at(i), at(i + 1));
-            (a.y.min(b.y), a.y.max(b.y), i)
-        })
-        .collect();
-    edges.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    // Horizontal strips of the y range, each listing the edges whose y-interval meets it
+    // (boundary edges are short, so most lie in one or two): a +x ray cast at height y only
+    // visits its strip.
+    let (mut y_lo, mut y_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for i in 0..m {
+        y_lo = y_lo.min(at(i).y);
+        y_hi = y_hi.max(at(i).y);
+    }
+    let strips = (m / 8).max(1);
+    let height = (y_hi - y_lo) / strips as f64;
+    let strip = |y: f64| -> usize {
+        if height > 0.0 && y.is_finite() {
+            (((y - y_lo) / height).max(0.0) as usize).min(strips - 1)
+        } else {
+            0
+        }
+    };
+    let mut edges: Vec<Vec<usize>> = vec![Vec::new(); strips];
+    for i in 0..m {
+        let (a, b) = (at(i), at(i + 1));
+        for e in &mut edges[strip(a.y.min(b.y))..=strip(a.y.max(b.y))] {
+            e.push(i);
+        }
+    }
     let mut out = Vec::new();
     for k in 0..m {
         let p = at(k);
@@ -494,11 +510,7 @@ fn penetrating_vertices(uv: &[Point2<f64>], boundary: &[VertexId], delta: f64) -
         let (c, s) = ((0.5 * ext).cos(), (0.5 * ext).sin());
         let q = p + Vector2::new(c * u1.x - s * u1.y, s * u1.x + c * u1.y) * delta;
         let mut winding = 0i32;
-        let end = edges.partition_point(|e| e.0 <= q.y);
-        for &(_, y1, i) in &edges[..end] {
-            if y1 < q.y {
-                continue; // entirely below the ray
-            }
+        for &i in &edges[strip(q.y)] {
             let (a, b) = (at(i), at(i + 1));
             // Half-open rule on y; count crossings of the ray x > q.x with sign.
             if (a.y <= q.y) != (b.y <= q.y) {
