@@ -14,6 +14,10 @@ use conemesh::patches::{cover, extract_patch, ConePatches, CoverOptions};
 use rand::SeedableRng;
 use std::time::Instant;
 
+fn env_usize(k: &str) -> Option<usize> {
+    std::env::var(k).ok().and_then(|s| s.parse().ok())
+}
+
 fn main() {
     let only = std::env::var("ONLY").unwrap_or_else(|_| "armadillo".to_string());
     let minf: usize = std::env::var("MINF")
@@ -48,6 +52,46 @@ fn main() {
             let Ok(pm) = extract_patch(&mesh, &p.faces) else {
                 continue;
             };
+            if let Some(reps) = env_usize("LSCMREPS") {
+                let mut best = f64::INFINITY;
+                for _ in 0..reps {
+                    let t = Instant::now();
+                    let _ = conemesh::param::lscm(&pm.mesh, &pm.boundary);
+                    best = best.min(t.elapsed().as_secs_f64() * 1e3);
+                }
+                println!(
+                    "{name} p{pi} {}f: lscm best of {reps} {best:.2} ms",
+                    p.faces.len()
+                );
+                continue;
+            }
+            // REPS=n: best-of-n wall time of the default parameterizer (initial map included).
+            if let Some(reps) = env_usize("REPS") {
+                use conemesh::param::Parameterizer;
+                let mut best = f64::INFINITY;
+                let mut rep = None;
+                for _ in 0..reps {
+                    let t = Instant::now();
+                    let mut sd = conemesh::param::SymmetricDirichlet::default();
+                    if let Some(x) = env_usize("RI") {
+                        sd.options.repair_iters = x;
+                    }
+                    let r = sd.parameterize(&pm.mesh, &pm.boundary);
+                    best = best.min(t.elapsed().as_secs_f64() * 1e3);
+                    rep = r.ok().map(|p| p.report);
+                }
+                if let Some(r) = rep {
+                    println!(
+                        "{name} p{pi} {}f: best of {reps} {best:.1} ms, it {} budget {} meanc {:.4} maxc {:.3}",
+                        p.faces.len(),
+                        r.iterations,
+                        r.hit_budget,
+                        r.mean_conformal,
+                        r.max_conformal
+                    );
+                }
+                continue;
+            }
             let t0 = Instant::now();
             let circle = circle_boundary(&pm.mesh, &pm.boundary, 1.0);
             let Ok(mut uv0) = tutte_embedding(&pm.mesh, &pm.boundary, &circle, TutteWeights::Cotan)
@@ -71,12 +115,151 @@ fn main() {
                     Err(e) => println!("  LSCM failed: {e}"),
                 }
             }
+            if std::env::var("REPAIR").is_ok() {
+                let tl = Instant::now();
+                let l = conemesh::param::lscm(&pm.mesh, &pm.boundary);
+                println!("  lscm {:.1} ms", tl.elapsed().as_secs_f64() * 1e3);
+                if let Ok(mut l) = l {
+                    scale_to_area(&pm.mesh, &mut l);
+                    let mut o = SdOptions {
+                        max_iters: env_usize("MI").unwrap_or(100),
+                        ..Default::default()
+                    };
+                    if let Ok(x) = std::env::var("RW") {
+                        o.repair_weight = x.parse().unwrap_or(0.0);
+                    }
+                    if let Ok(x) = std::env::var("RM") {
+                        o.repair_margin = x.parse().unwrap_or(0.1);
+                    }
+                    match conemesh::param::optimize_locally_injective(
+                        &pm.mesh,
+                        &pm.boundary,
+                        &l,
+                        &o,
+                    ) {
+                        Ok((u, log)) => {
+                            let c = conemesh::invariants::certify_bijective(
+                                &u,
+                                &pm.mesh.triangles,
+                                &pm.boundary,
+                            );
+                            let r = distortion(&pm.mesh, &u);
+                            if let Ok(dir) = std::env::var("DUMP") {
+                                let j = serde_json::json!({
+                                    "uv": u.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
+                                    "tris": pm.mesh.triangles.iter().map(|t| [t[0].idx(), t[1].idx(), t[2].idx()]).collect::<Vec<_>>(),
+                                    "boundary": pm.boundary.iter().map(|v| v.idx()).collect::<Vec<_>>(),
+                                });
+                                let _ = std::fs::write(
+                                    format!("{dir}/{name}_p{pi}.json"),
+                                    j.to_string(),
+                                );
+                            }
+                            println!(
+                                "  repair: it {} split {:.1?} E {:.4} maxc {:.3} meanc {:.4} ms {:.1} cert {:?}",
+                                log.iterations,
+                                log.time_ms,
+                                log.energies.last().copied().unwrap_or(f64::NAN),
+                                r.max_conformal,
+                                r.mean_conformal,
+                                t0.elapsed().as_secs_f64() * 1e3,
+                                c.err().map(|e| e
+                                    .to_string()
+                                    .chars()
+                                    .take(300)
+                                    .collect::<String>())
+                            );
+                        }
+                        Err(e) => println!("  repair failed: {e}"),
+                    }
+                }
+            }
+            if std::env::var("BLEND").is_ok() {
+                let tb = Instant::now();
+                let o = SdOptions::default();
+                let mut l = conemesh::param::lscm(&pm.mesh, &pm.boundary).unwrap();
+                scale_to_area(&pm.mesh, &mut l);
+                let (mut us, _) =
+                    conemesh::param::optimize_locally_injective(&pm.mesh, &pm.boundary, &l, &o)
+                        .unwrap();
+                scale_to_area(&pm.mesh, &mut us);
+                let t = uv0.clone();
+                // Procrustes: rotate/translate us onto t.
+                let n = t.len() as f64;
+                let ct = t
+                    .iter()
+                    .fold(nalgebra::Vector2::zeros(), |a, p| a + p.coords)
+                    / n;
+                let cu = us
+                    .iter()
+                    .fold(nalgebra::Vector2::zeros(), |a, p| a + p.coords)
+                    / n;
+                let (mut sc, mut ss) = (0.0, 0.0);
+                for (a, b) in us.iter().zip(&t) {
+                    let (x, y) = (a.coords - cu, b.coords - ct);
+                    sc += x.dot(&y);
+                    ss += x.perp(&y);
+                }
+                let th = ss.atan2(sc);
+                let (c, s) = (th.cos(), th.sin());
+                for p in us.iter_mut() {
+                    let x = p.coords - cu;
+                    *p = nalgebra::Point2::from(
+                        nalgebra::Vector2::new(c * x.x - s * x.y, s * x.x + c * x.y) + ct,
+                    );
+                }
+                let blend = |lam: f64| -> Vec<nalgebra::Point2<f64>> {
+                    t.iter()
+                        .zip(&us)
+                        .map(|(a, b)| {
+                            nalgebra::Point2::from(a.coords * (1.0 - lam) + b.coords * lam)
+                        })
+                        .collect()
+                };
+                let ok = |lam: f64| {
+                    conemesh::invariants::certify_bijective(
+                        &blend(lam),
+                        &pm.mesh.triangles,
+                        &pm.boundary,
+                    )
+                    .is_ok()
+                };
+                let (mut lo, mut hi) = (0.0, 1.0);
+                if ok(1.0) {
+                    lo = 1.0;
+                } else {
+                    for _ in 0..env_usize("BS").unwrap_or(8) {
+                        let mid = 0.5 * (lo + hi);
+                        if ok(mid) {
+                            lo = mid
+                        } else {
+                            hi = mid
+                        }
+                    }
+                }
+                let b = blend(lo);
+                println!(
+                    "  blend lambda {lo:.4} E0 {:.3} ms {:.1}",
+                    distortion(&pm.mesh, &b).symmetric_dirichlet,
+                    tb.elapsed().as_secs_f64() * 1e3
+                );
+                uv0 = b;
+            }
             // INIT=1: the parameterizer's own initial map (INIT=0: without the ellipse Tutte).
             if let Ok(v) = std::env::var("INIT") {
-                let o = SdOptions {
+                let mut o = SdOptions {
                     shaped_tutte_init: v != "0",
                     ..Default::default()
                 };
+                if let Some(x) = env_usize("RI") {
+                    o.repair_iters = x;
+                }
+                if let Ok(x) = std::env::var("RW") {
+                    o.repair_weight = x.parse().unwrap_or(100.0);
+                }
+                if let Ok(x) = std::env::var("RM") {
+                    o.repair_margin = x.parse().unwrap_or(0.1);
+                }
                 match conemesh::param::initial_map(&pm.mesh, &pm.boundary, &o) {
                     Ok((u, kind)) => {
                         println!("  init {kind:?}");
@@ -105,6 +288,15 @@ fn main() {
             }
             if let Some(x) = env("COLL") {
                 opts.collision_bound = x > 0.0;
+            }
+            if let Some(x) = env("CAB") {
+                opts.collision_active_below = x;
+            }
+            if let Some(x) = env("CR") {
+                opts.collision_rounds = x as usize;
+            }
+            if let Some(x) = env("CK") {
+                opts.collision_stiffness = x;
             }
             if let Some(x) = env("SF") {
                 opts.step_fraction = x;

@@ -662,3 +662,122 @@ fn cgal_hausdorff_matches_the_analytic_distance_of_offset_spheres() {
 
 // The Hausdorff cross-check against conemesh's own measure lives in tests/cgal_pipeline.rs
 // (outputs of `conemesh remesh` against their inputs).
+
+// ---------------------------------------------------------------------------------------
+// Parameterizations of real cover patches (issue 7: "The CGAL check program certifies our
+// output orientation and boundary simplicity independently and must agree").
+
+#[path = "common/param_cover.rs"]
+mod param_cover;
+
+/// Write the flat map `uv` of `disk` as an OFF with z = 0 (the checker's `xy` source).
+fn write_flat(path: &Path, disk: &TriMesh, uv: &[Point2<f64>]) {
+    let pos: Vec<[f64; 3]> = uv.iter().map(|p| [p.x, p.y, 0.0]).collect();
+    let tris: Vec<[usize; 3]> = disk
+        .triangles
+        .iter()
+        .map(|t| [t[0].idx(), t[1].idx(), t[2].idx()])
+        .collect();
+    write_off(path, &mesh(&pos, &tris));
+}
+
+/// CGAL's planar verdict on `uv` against `certify_bijective` and `non_positive_faces`;
+/// returns whether conemesh certified the map.
+fn planar_agrees(
+    dir: &Path,
+    name: &str,
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    uv: &[Point2<f64>],
+) -> bool {
+    let path = dir.join(format!("{name}.off"));
+    write_flat(&path, disk, uv);
+    let cgal = run_checker(&path, &["--planar"]);
+    let pl = &cgal["planar"];
+    assert_eq!(pl["source"], "xy", "{name}");
+    let ours_np: Vec<usize> = invariants::non_positive_faces(uv, &disk.triangles)
+        .into_iter()
+        .map(FaceId::idx)
+        .collect();
+    assert_eq!(
+        pl["non_positive_faces"],
+        Value::from(ours_np.clone()),
+        "{name}: non-positive faces"
+    );
+    assert_eq!(
+        pl["boundary_loops"],
+        Value::from(1),
+        "{name}: boundary loops"
+    );
+    let certified = invariants::certify_bijective(uv, &disk.triangles, boundary).is_ok();
+    // certify_bijective = every face positive + simple boundary + counter-clockwise boundary
+    // (surface on the left); CGAL's border halfedges run against the faces, so that outer
+    // boundary is "cw (faces ccw inside)" there.
+    let cgal_bijective = pl["all_positively_oriented"] == Value::Bool(true)
+        && pl["boundary_simple"] == Value::Bool(true)
+        && pl["boundary_loop_orientation"][0] == "cw (faces ccw inside)";
+    assert_eq!(
+        cgal_bijective, certified,
+        "{name}: CGAL says {pl}, certify_bijective says {certified}"
+    );
+    certified
+}
+
+#[test]
+#[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
+fn cover_patch_parameterizations_agree_with_cgal() {
+    use conemesh::param::{lscm, scale_to_area, Parameterizer, SymmetricDirichlet};
+    use conemesh::patches::{cover, extract_patch, ConePatches, CoverOptions};
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (mut checked, mut overlapping_lscm) = (0, 0);
+    for name in ["fertility.off", "stanford-bunny.obj"] {
+        let m = param_cover::load(name).expect("shared mesh");
+        let mut rng = conemesh::Rng::seed_from_u64(1);
+        let run = cover(
+            &m,
+            &ConePatches::default(),
+            &CoverOptions::default(),
+            &mut rng,
+        )
+        .expect("cover");
+        // The large patches (the hard, Tutte-started ones among them) and a few small ones.
+        let mut order: Vec<usize> = (0..run.patches.len()).collect();
+        order.sort_by_key(|&i| std::cmp::Reverse(run.patches[i].faces.len()));
+        order.truncate(6);
+        order.extend((0..run.patches.len()).rev().take(2));
+        order.sort_unstable();
+        order.dedup();
+        for pi in order {
+            let pm = extract_patch(&m, &run.patches[pi].faces).expect("extract");
+            let p = SymmetricDirichlet::default()
+                .parameterize(&pm.mesh, &pm.boundary)
+                .expect("parameterize");
+            let case = format!("{name}_p{pi}");
+            assert!(
+                planar_agrees(dir.path(), &case, &pm.mesh, &pm.boundary, &p.uv),
+                "{case}: the parameterizer's output is not certified"
+            );
+            checked += 1;
+            // The free-boundary LSCM often overlaps on these patches: both sides must then
+            // reject it (the negative half of the cross-check).
+            if let Ok(mut l) = lscm(&pm.mesh, &pm.boundary) {
+                scale_to_area(&pm.mesh, &mut l);
+                if !planar_agrees(
+                    dir.path(),
+                    &format!("{case}_lscm"),
+                    &pm.mesh,
+                    &pm.boundary,
+                    &l,
+                ) {
+                    overlapping_lscm += 1;
+                }
+            }
+        }
+    }
+    assert!(checked >= 10, "{checked} patches checked");
+    // Known from the covering runs (bunny p2, p11 start from Tutte because of this).
+    assert!(
+        overlapping_lscm >= 2,
+        "{overlapping_lscm} overlapping LSCM maps"
+    );
+}

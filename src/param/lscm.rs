@@ -9,25 +9,26 @@ use super::distortion::triangle_frames;
 use super::ParamError;
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
-use faer::linalg::solvers::Solve;
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Side};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
+use faer::{Conj, Mat, Par, Side};
 use nalgebra::Point2;
 
-/// LSCM of `disk`: minimises `Σ_t A_t ((a − d)² + (b + c)²)` over the Jacobians
-/// `F = [[a, b], [c, d]]` (`= Σ_t A_t (‖F‖² − 2 det F)`, zero exactly for a similarity),
-/// with the two boundary vertices farthest apart in 3D pinned at their 3D distance.
-/// Solved by faer's sparse Cholesky. No certification, no area scaling.
-pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, ParamError> {
-    let n = disk.n_vertices();
+/// The two pinned vertices of [`lscm`] and their 3D distance: a boundary vertex and the
+/// boundary vertex farthest from it, then the one farthest from that (two sweeps of the
+/// diameter heuristic).
+pub(super) fn pins(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+) -> Result<(VertexId, VertexId, f64), ParamError> {
     if boundary.len() < 3 {
         return Err(ParamError::NotADisk(format!(
             "boundary of {} vertices",
             boundary.len()
         )));
     }
-    // Pins: a boundary vertex and the boundary vertex farthest from it, then the one
-    // farthest from that (two sweeps of the diameter heuristic).
     let far = |from: VertexId| -> VertexId {
         let p = disk.position(from);
         *boundary
@@ -44,7 +45,37 @@ pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, P
     if p0 == p1 {
         return Err(ParamError::Solver("LSCM: coincident pins".to_string()));
     }
-    let dist = (disk.position(p1) - disk.position(p0)).norm();
+    Ok((p0, p1, (disk.position(p1) - disk.position(p0)).norm()))
+}
+
+/// The rows of `a − d` and `b + c` of a triangle's Jacobian over its local dofs `2k + c`
+/// (`F_ij = Σ_k u_{k,i} g_k[j]`): the LSCM energy of the triangle is
+/// `A_t ((r1·u)² + (r2·u)²)`.
+pub(super) fn conformal_rows(g: &[[f64; 2]; 3]) -> ([f64; 6], [f64; 6]) {
+    let mut r1 = [0.0; 6];
+    let mut r2 = [0.0; 6];
+    for k in 0..3 {
+        r1[2 * k] = g[k][0];
+        r1[2 * k + 1] = -g[k][1];
+        r2[2 * k] = g[k][1];
+        r2[2 * k + 1] = g[k][0];
+    }
+    (r1, r2)
+}
+
+/// LSCM of `disk`: minimises `Σ_t A_t ((a − d)² + (b + c)²)` over the Jacobians
+/// `F = [[a, b], [c, d]]` (`= Σ_t A_t (‖F‖² − 2 det F)`, zero exactly for a similarity),
+/// with the two boundary vertices farthest apart in 3D pinned at their 3D distance.
+/// Solved by faer's sparse Cholesky. No certification, no area scaling.
+pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, ParamError> {
+    let n = disk.n_vertices();
+    if boundary.len() < 3 {
+        return Err(ParamError::NotADisk(format!(
+            "boundary of {} vertices",
+            boundary.len()
+        )));
+    }
+    let (p0, p1, dist) = pins(disk, boundary)?;
     const FIXED: usize = usize::MAX;
     let mut uv = vec![Point2::origin(); n];
     uv[p1.idx()] = Point2::new(dist, 0.0);
@@ -75,16 +106,7 @@ pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, P
         if fr.area <= 0.0 {
             continue;
         }
-        let g = fr.grad;
-        // Rows of a − d and b + c over the local dofs (2k + c): F_ij = Σ_k u_{k,i} g_k[j].
-        let mut r1 = [0.0; 6];
-        let mut r2 = [0.0; 6];
-        for k in 0..3 {
-            r1[2 * k] = g[k][0];
-            r1[2 * k + 1] = -g[k][1];
-            r2[2 * k] = g[k][1];
-            r2[2 * k + 1] = g[k][0];
-        }
+        let (r1, r2) = conformal_rows(&fr.grad);
         let dof = |l: usize| 2 * t[l / 2].idx() + l % 2;
         for l1 in 0..6 {
             let i = index[dof(l1)];
@@ -102,10 +124,7 @@ pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, P
     }
     let a = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &trips)
         .map_err(|e| ParamError::Solver(format!("assembling LSCM: {e:?}")))?;
-    let sol = a
-        .sp_cholesky(Side::Lower)
-        .map_err(|e| ParamError::Solver(format!("LSCM Cholesky: {e:?}")))?
-        .solve(&rhs);
+    let sol = cholesky_solve(a.as_ref(), rhs)?;
     for v in 0..n {
         for c in 0..2 {
             let i = index[2 * v + c];
@@ -123,6 +142,43 @@ pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, P
         )));
     }
     Ok(uv)
+}
+
+/// Solve `a x = rhs` (symmetric positive definite, full storage) by sparse Cholesky; the
+/// supernodal kernel is forced from the size where it wins for the 2D-mesh matrices of
+/// Sec. 3.3 (as for the Newton Hessian, `super::sdirichlet`).
+fn cholesky_solve(
+    a: SparseColMatRef<'_, usize, f64>,
+    mut rhs: Mat<f64>,
+) -> Result<Mat<f64>, ParamError> {
+    let err =
+        |what: &str, e: &dyn std::fmt::Debug| ParamError::Solver(format!("LSCM {what}: {e:?}"));
+    let mut params = CholeskySymbolicParams::default();
+    if a.nrows() >= super::sdirichlet::SUPERNODAL_MIN_DIM {
+        params.supernodal_flop_ratio_threshold = SupernodalThreshold::FORCE_SUPERNODAL;
+    }
+    let symbolic =
+        factorize_symbolic_cholesky(a.symbolic(), Side::Lower, Default::default(), params)
+            .map_err(|e| err("symbolic Cholesky", &e))?;
+    let mut l_values = vec![0.0; symbolic.len_val()];
+    let mut mem = MemBuffer::new(
+        symbolic
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+    );
+    let llt = symbolic
+        .factorize_numeric_llt::<f64>(
+            &mut l_values,
+            a,
+            Side::Lower,
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .map_err(|e| err("Cholesky", &e))?;
+    llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), Par::Seq, MemStack::new(&mut mem));
+    Ok(rhs)
 }
 
 #[cfg(test)]

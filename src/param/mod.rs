@@ -10,7 +10,8 @@ mod tutte;
 pub use distortion::{distortion, triangle_frames, TriangleFrame};
 pub use lscm::lscm;
 pub use sdirichlet::{
-    initial_map, optimize_with_log, InitialMap, SdLog, SdOptions, SymmetricDirichlet,
+    initial_map, optimize_locally_injective, optimize_with_log, InitialMap, SdLog, SdOptions,
+    SymmetricDirichlet,
 };
 pub use shaped::ellipse_boundary;
 pub use tutte::{circle_boundary, scale_to_area, tutte_embedding, Tutte, TutteWeights};

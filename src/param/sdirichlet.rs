@@ -14,6 +14,9 @@
 //!   (zero exactly when `p` touches the edge) enters `(ε/d − 1)²` while `d < ε`, with `ε`
 //!   a fraction of the mean edge length. Its Hessian is the Gauss–Newton term, kept on the
 //!   2×2 diagonal blocks so the sparsity pattern does not change.
+//! * Start: the free-boundary LSCM when certified; else the LSCM after the overlap repair
+//!   (`repair_iters`) when that is certified; else the Tutte map. The repair steps are part
+//!   of computing the start: only the certified start and the iterates after it count.
 //! * Line search: the largest flip-free step (smallest positive root of `det J(t) = 0` over
 //!   all triangles) times `step_fraction`, then Armijo backtracking; a trial is accepted only
 //!   if `certify_bijective` (exact) passes, so every iterate is certified.
@@ -26,11 +29,13 @@ use super::{
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, Par, Side};
 use nalgebra::{Matrix4, Point2, Vector2, Vector4};
+use std::cell::OnceCell;
 
 /// Options of [`SymmetricDirichlet`] (defaults in brackets).
 #[derive(Copy, Clone, Debug, PartialEq)]
@@ -74,6 +79,27 @@ pub struct SdOptions {
     /// When the LSCM is not certified, start from the Tutte map onto the ellipse of the
     /// LSCM boundary before falling back to the circle [true].
     pub shaped_tutte_init: bool,
+    /// Overlap repair of an LSCM that is not certified (its boundary overlaps itself, mostly
+    /// where narrow slits of a ragged cover patch close): up to this many locally injective
+    /// Newton steps from it on the symmetric Dirichlet energy plus a penalty pushing every
+    /// penetrating boundary vertex `repair_margin` back out of the edge it crossed (no
+    /// barrier, no certificate during the steps; stops early once certified, or when the
+    /// number of crossing boundary edges has not fallen for 6 steps). The result is used
+    /// only if it passes the exact certificate, else the Tutte map [30]; 0 disables.
+    pub repair_iters: usize,
+    /// Weight of one overlap-repair term relative to one average triangle's energy share
+    /// (0: plain locally injective steps) [100].
+    pub repair_weight: f64,
+    /// Clearance the overlap repair aims for, as a fraction of the mean 3D edge length [0.2].
+    pub repair_margin: f64,
+    /// Active set of the collision bound: when the bound cuts the step below this fraction
+    /// of the wanted step, re-solve with the colliding vertices stiffened along the edge
+    /// normal [0: measured slower, see paper-notes]; 0 disables.
+    pub collision_active_below: f64,
+    /// Re-solves per iteration for the active set [2].
+    pub collision_rounds: usize,
+    /// Stiffness of an active pair relative to the mean Hessian diagonal [1e3].
+    pub collision_stiffness: f64,
 }
 
 impl Default for SdOptions {
@@ -90,6 +116,12 @@ impl Default for SdOptions {
             abs_twist: true,
             collision_bound: true,
             shaped_tutte_init: false,
+            repair_iters: 30,
+            repair_weight: 100.0,
+            repair_margin: 0.2,
+            collision_active_below: 0.0,
+            collision_rounds: 2,
+            collision_stiffness: 1e3,
         }
     }
 }
@@ -209,8 +241,131 @@ impl Pattern {
     }
 }
 
+/// Overlap repair iterations without fewer crossing boundary edges before it gives up.
+const REPAIR_PATIENCE: usize = 6;
+
 /// Hessian dimension (2 × vertices) from which the supernodal Cholesky is forced.
-const SUPERNODAL_MIN_DIM: usize = 2000;
+pub(super) const SUPERNODAL_MIN_DIM: usize = 2000;
+
+/// What the Newton iterations on one disk share: the Hessian pattern and its symbolic
+/// Cholesky factorisation (AMD ordering). Built once per disk and reused by the overlap
+/// repair and the certified optimisation (~3.5 ms on a 5,000-face patch).
+struct Setup {
+    pat: Pattern,
+    symbolic: SymbolicCholesky<usize>,
+}
+
+impl Setup {
+    fn new(disk: &TriMesh) -> Result<Setup, ParamError> {
+        let pat = Pattern::new(disk.n_vertices(), &disk.triangles);
+        let dim = 2 * disk.n_vertices();
+        let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
+        // One symbolic factorisation for all iterations. Sequential (`Par::Seq`): the result
+        // must not depend on the thread count (same seed → same bytes), and small
+        // factorisations gain little from threads.
+        let symbolic = factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), {
+            // Supernodal from SUPERNODAL_MIN_DIM dofs: faer's automatic choice picks the
+            // simplicial kernel for these 2D-mesh Hessians, measured ~25–50% slower per
+            // factorisation on 5k–15k-face cover patches (the 2×2 vertex blocks make dense
+            // supernodes); small patches keep the automatic choice.
+            let mut p = CholeskySymbolicParams::default();
+            if dim >= SUPERNODAL_MIN_DIM {
+                p.supernodal_flop_ratio_threshold = SupernodalThreshold::FORCE_SUPERNODAL;
+            }
+            p
+        })
+        .map_err(|e| ParamError::Solver(format!("symbolic Cholesky: {e:?}")))?;
+        Ok(Setup { pat, symbolic })
+    }
+
+    /// The shared setup, built on first use.
+    fn get<'a>(cell: &'a OnceCell<Setup>, disk: &TriMesh) -> Result<&'a Setup, ParamError> {
+        if let Some(s) = cell.get() {
+            return Ok(s);
+        }
+        let s = Setup::new(disk)?;
+        Ok(cell.get_or_init(|| s))
+    }
+}
+
+/// [`super::lscm()`] through the shared Newton [`Setup`]: the LSCM normal matrix has the
+/// Hessian's pattern, so it is assembled into the pattern's slots (pinned dofs become
+/// identity rows) and factorised with the symbolic factorisation the optimisation reuses,
+/// instead of sorting triplets and ordering a second time. Same pins, same minimiser.
+fn lscm_shared(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    setup: &Setup,
+) -> Result<Vec<Point2<f64>>, ParamError> {
+    let (p0, p1, dist) = super::lscm::pins(disk, boundary)?;
+    let n = disk.n_vertices();
+    let dim = 2 * n;
+    let pat = &setup.pat;
+    let mut fixed = vec![None; dim];
+    fixed[2 * p0.idx()] = Some(0.0);
+    fixed[2 * p0.idx() + 1] = Some(0.0);
+    fixed[2 * p1.idx()] = Some(dist);
+    fixed[2 * p1.idx() + 1] = Some(0.0);
+    let mut vals = vec![0.0; pat.row_idx.len()];
+    let mut sol = Mat::<f64>::zeros(dim, 1);
+    for (ti, (t, fr)) in disk.triangles.iter().zip(triangle_frames(disk)).enumerate() {
+        if fr.area <= 0.0 {
+            continue;
+        }
+        let (r1, r2) = super::lscm::conformal_rows(&fr.grad);
+        let dof = |l: usize| 2 * t[l / 2].idx() + l % 2;
+        for l1 in 0..6 {
+            if fixed[dof(l1)].is_some() {
+                continue;
+            }
+            for l2 in 0..6 {
+                let w = fr.area * (r1[l1] * r1[l2] + r2[l1] * r2[l2]);
+                match fixed[dof(l2)] {
+                    Some(x) => sol[(dof(l1), 0)] -= w * x,
+                    None => vals[pat.tri_slots[ti][l1 * 6 + l2] as usize] += w,
+                }
+            }
+        }
+    }
+    for (d, x) in fixed.iter().enumerate() {
+        if let Some(x) = x {
+            vals[pat.diag_slots[d / 2][if d % 2 == 0 { 0 } else { 3 }] as usize] = 1.0;
+            sol[(d, 0)] = *x;
+        }
+    }
+    let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
+    let symbolic = &setup.symbolic;
+    let mut l_values = vec![0.0; symbolic.len_val()];
+    let mut mem = MemBuffer::new(
+        symbolic
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+    );
+    let llt = symbolic
+        .factorize_numeric_llt::<f64>(
+            &mut l_values,
+            SparseColMatRef::new(sym, &vals),
+            Side::Lower,
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .map_err(|e| ParamError::Solver(format!("LSCM Cholesky: {e:?}")))?;
+    llt.solve_in_place_with_conj(Conj::No, sol.as_mut(), Par::Seq, MemStack::new(&mut mem));
+    let uv: Vec<Point2<f64>> = (0..n)
+        .map(|v| Point2::new(sol[(2 * v, 0)], sol[(2 * v + 1, 0)]))
+        .collect();
+    if let Some(v) = uv
+        .iter()
+        .position(|p| !(p.x.is_finite() && p.y.is_finite()))
+    {
+        return Err(ParamError::Solver(format!(
+            "LSCM gave a non-finite position for v{v}"
+        )));
+    }
+    Ok(uv)
+}
 
 /// Energy, gradient and projected Hessian of one triangle with respect to `vec(F)`
 /// (row-major `a, b, c, d`). `None` when `det F ≤ 0` (infinite energy).
@@ -306,6 +461,118 @@ fn barrier_pairs(
     out
 }
 
+/// Boundary vertices (loop indices) that lie inside the image of another part of the disk:
+/// a point a hair (`delta`) outside the vertex, along the bisector of its exterior angle,
+/// has a non-zero winding number with respect to the boundary polygon (it would be 0 for a
+/// simple counter-clockwise boundary). Float arithmetic: this only steers the overlap
+/// repair; the exact certificate judges its result.
+fn penetrating_vertices(uv: &[Point2<f64>], boundary: &[VertexId], delta: f64) -> Vec<usize> {
+    let m = boundary.len();
+    let at = |i: usize| uv[boundary[i % m].idx()];
+    // Horizontal strips of the y range, each listing the edges whose y-interval meets it
+    // (boundary edges are short, so most lie in one or two): a +x ray cast at height y only
+    // visits its strip.
+    let (mut y_lo, mut y_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for i in 0..m {
+        y_lo = y_lo.min(at(i).y);
+        y_hi = y_hi.max(at(i).y);
+    }
+    let strips = (m / 8).max(1);
+    let height = (y_hi - y_lo) / strips as f64;
+    let strip = |y: f64| -> usize {
+        if height > 0.0 && y.is_finite() {
+            (((y - y_lo) / height).max(0.0) as usize).min(strips - 1)
+        } else {
+            0
+        }
+    };
+    let mut edges: Vec<Vec<usize>> = vec![Vec::new(); strips];
+    for i in 0..m {
+        let (a, b) = (at(i), at(i + 1));
+        for e in &mut edges[strip(a.y.min(b.y))..=strip(a.y.max(b.y))] {
+            e.push(i);
+        }
+    }
+    let mut out = Vec::new();
+    for k in 0..m {
+        let p = at(k);
+        let (u1, u2) = (at(k + m - 1) - p, at(k + 1) - p);
+        let (l1, l2) = (u1.norm(), u2.norm());
+        if l1 <= 0.0 || l2 <= 0.0 {
+            continue;
+        }
+        let (u1, u2) = (u1 / l1, u2 / l2);
+        // The material lies counter-clockwise from u2 to u1, the exterior from u1 to u2.
+        let mut ext = u1.perp(&u2).atan2(u1.dot(&u2));
+        if ext <= 0.0 {
+            ext += std::f64::consts::TAU;
+        }
+        let (c, s) = ((0.5 * ext).cos(), (0.5 * ext).sin());
+        let q = p + Vector2::new(c * u1.x - s * u1.y, s * u1.x + c * u1.y) * delta;
+        let mut winding = 0i32;
+        for &i in &edges[strip(q.y)] {
+            let (a, b) = (at(i), at(i + 1));
+            // Half-open rule on y; count crossings of the ray x > q.x with sign.
+            if (a.y <= q.y) != (b.y <= q.y) {
+                let x = a.x + (q.y - a.y) * (b.x - a.x) / (b.y - a.y);
+                if x > q.x {
+                    winding += if b.y > a.y { 1 } else { -1 };
+                }
+            }
+        }
+        if winding != 0 {
+            out.push(k);
+        }
+    }
+    out
+}
+
+/// For a penetrating boundary vertex (loop index `k`), the boundary edge it has to leave:
+/// the nearest edge not within two steps along the loop that has `p` on its inner (left)
+/// side. Returns the edge's loop index.
+fn edge_to_leave(uv: &[Point2<f64>], boundary: &[VertexId], k: usize) -> Option<usize> {
+    let m = boundary.len();
+    let at = |i: usize| uv[boundary[i % m].idx()];
+    let p = at(k);
+    let mut best: Option<(f64, usize)> = None;
+    for e in 0..m {
+        let gap = (k + m - e) % m;
+        if gap <= 2 || gap >= m - 1 {
+            continue;
+        }
+        let (a, b) = (at(e), at(e + 1));
+        let ab = b - a;
+        let l2 = ab.norm_squared();
+        if l2 <= 0.0 || ab.perp(&(p - a)) <= 0.0 {
+            continue;
+        }
+        let u = ((p - a).dot(&ab) / l2).clamp(0.0, 1.0);
+        let d = (p - (a + ab * u)).norm_squared();
+        if best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, e));
+        }
+    }
+    best.map(|(_, e)| e)
+}
+
+/// Signed distance of `uv[p]` from the line of `ab`, positive on the inner (left) side, with
+/// the inner unit normal and the clamped projection parameter along `ab`.
+fn signed_gap(
+    uv: &[Point2<f64>],
+    p: usize,
+    a: usize,
+    b: usize,
+) -> Option<(f64, (Vector2<f64>, f64))> {
+    let ab = uv[b] - uv[a];
+    let l = ab.norm();
+    if l <= 0.0 {
+        return None;
+    }
+    let nl = Vector2::new(-ab.y, ab.x) / l;
+    let w = uv[p] - uv[a];
+    Some((w.dot(&nl), (nl, (w.dot(&ab) / (l * l)).clamp(0.0, 1.0))))
+}
+
 /// The optimisation problem: rest frames, pattern, scales.
 struct Problem<'a> {
     tris: &'a [[VertexId; 3]],
@@ -314,6 +581,11 @@ struct Problem<'a> {
     total_area: f64,
     eps: f64,
     barrier_w: f64,
+    /// Overlap repair: weight (0 = off), clearance, and the (vertex, edge start, edge end)
+    /// pairs found by [`penetrating_vertices`] so far.
+    pen_w: f64,
+    pen_margin: f64,
+    pen_pairs: Vec<[usize; 3]>,
 }
 
 impl Problem<'_> {
@@ -337,6 +609,14 @@ impl Problem<'_> {
                 return f64::INFINITY;
             }
             e += self.barrier_w * (self.eps / d - 1.0).powi(2);
+        }
+        for &[p, a, b] in &self.pen_pairs {
+            if let Some((sd, _)) = signed_gap(uv, p, a, b) {
+                let x = (sd + self.pen_margin) / self.pen_margin;
+                if x > 0.0 {
+                    e += self.pen_w * x * x;
+                }
+            }
         }
         e
     }
@@ -423,6 +703,29 @@ impl Problem<'_> {
                 vals[s[3] as usize] += d2 * gv.y * gv.y;
             }
         }
+        // Overlap repair: w ((s + margin) / margin)² while positive, s the signed distance of
+        // p inside the line of ab; gradient along the edge's inner normal (p moves out, a and b
+        // by their share), Gauss–Newton diagonal blocks.
+        let k = self.pen_w / (self.pen_margin * self.pen_margin);
+        for &[p, a, b] in &self.pen_pairs {
+            let Some((sd, (nl, u))) = signed_gap(uv, p, a, b) else {
+                continue;
+            };
+            if sd + self.pen_margin <= 0.0 {
+                continue;
+            }
+            let d1 = 2.0 * k * (sd + self.pen_margin);
+            for (v, c) in [(p, 1.0), (a, -(1.0 - u)), (b, -u)] {
+                grad[2 * v] += d1 * c * nl.x;
+                grad[2 * v + 1] += d1 * c * nl.y;
+                let h = 2.0 * k * c * c;
+                let s = &pat.diag_slots[v];
+                vals[s[0] as usize] += h * nl.x * nl.x;
+                vals[s[1] as usize] += h * nl.y * nl.x;
+                vals[s[2] as usize] += h * nl.x * nl.y;
+                vals[s[3] as usize] += h * nl.y * nl.y;
+            }
+        }
         Ok(())
     }
 
@@ -454,11 +757,24 @@ impl Problem<'_> {
 /// root counts when `p` then lies on the segment (with a small margin: over-counting only
 /// shortens the step). Broad phase: sort-and-sweep on x over the boxes swept in
 /// `[0, horizon]`, like the certificate's. The exact certificate stays the final judge.
+#[cfg(test)]
 fn max_collision_free_step(
     uv: &[Point2<f64>],
     dir: &[f64],
     boundary: &[VertexId],
     horizon: f64,
+) -> f64 {
+    collisions(uv, dir, boundary, horizon, &mut Vec::new())
+}
+
+/// [`max_collision_free_step`], also listing in `hits` every (vertex, edge start, edge end)
+/// triple (vertex indices) that meets within `horizon`.
+fn collisions(
+    uv: &[Point2<f64>],
+    dir: &[f64],
+    boundary: &[VertexId],
+    horizon: f64,
+    hits: &mut Vec<[usize; 3]>,
 ) -> f64 {
     let m = boundary.len();
     if m < 4 || horizon.is_nan() || horizon <= 0.0 {
@@ -489,7 +805,7 @@ fn max_collision_free_step(
     items.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
     let mut tmax = horizon;
     let mut active: Vec<usize> = Vec::new();
-    let test = |vi: usize, ei: usize, tmax: &mut f64| {
+    let mut test = |vi: usize, ei: usize, tmax: &mut f64| {
         if vi == ei || vi == (ei + 1) % m {
             return;
         }
@@ -501,18 +817,21 @@ fn max_collision_free_step(
         let c0 = e.perp(&w);
         let c1 = e.perp(&dw) + de.perp(&w);
         let c2 = de.perp(&dw);
-        let mut check = |s: f64| {
-            if s > 0.0 && s < *tmax {
+        let mut hit = false;
+        for s in quadratic_roots(c2, c1, c0) {
+            if s > 0.0 && s < horizon {
                 let (es, ws) = (e + de * s, w + dw * s);
                 let l2 = es.norm_squared();
                 let u = if l2 > 0.0 { es.dot(&ws) / l2 } else { 0.5 };
                 if (-1e-6..=1.0 + 1e-6).contains(&u) {
-                    *tmax = s;
+                    *tmax = tmax.min(s);
+                    hit = true;
                 }
             }
-        };
-        for r in quadratic_roots(c2, c1, c0) {
-            check(r);
+        }
+        if hit {
+            let b = |i: usize| boundary[i % m].idx();
+            hits.push([b(vi), b(ei), b(ei + 1)]);
         }
     };
     for k in 0..items.len() {
@@ -598,6 +917,87 @@ fn min_double_area(uv: &[Point2<f64>], tris: &[[VertexId; 3]]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Pairs of non-adjacent boundary edges (loop indices) whose segments cross or touch (float
+/// orientation tests; sort-and-sweep on x).
+fn crossing_edges(uv: &[Point2<f64>], boundary: &[VertexId]) -> Vec<(usize, usize)> {
+    let m = boundary.len();
+    let at = |i: usize| uv[boundary[i % m].idx()];
+    let mut items: Vec<(f64, f64, f64, f64, usize)> = (0..m)
+        .map(|i| {
+            let (a, b) = (at(i), at(i + 1));
+            (a.x.min(b.x), a.x.max(b.x), a.y.min(b.y), a.y.max(b.y), i)
+        })
+        .collect();
+    items.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    let orient = |a: Point2<f64>, b: Point2<f64>, c: Point2<f64>| (b - a).perp(&(c - a));
+    let mut out = Vec::new();
+    let mut active: Vec<usize> = Vec::new();
+    for k in 0..items.len() {
+        let (x0, _, y0, y1, i) = items[k];
+        active.retain(|&j| items[j].1 >= x0);
+        for &j in &active {
+            let (_, _, yj0, yj1, e) = items[j];
+            if yj1 < y0 || yj0 > y1 || (i + 1) % m == e || (e + 1) % m == i {
+                continue;
+            }
+            let (a, b, c, d) = (at(i), at(i + 1), at(e), at(e + 1));
+            let (o1, o2) = (orient(a, b, c), orient(a, b, d));
+            let (o3, o4) = (orient(c, d, a), orient(c, d, b));
+            if o1 * o2 <= 0.0 && o3 * o4 <= 0.0 {
+                out.push((i, e));
+            }
+        }
+        active.push(k);
+    }
+    out
+}
+
+/// Add a repair pair for every boundary vertex of `uv` that now penetrates another part of
+/// the disk (and has none yet), and for the endpoints of crossing boundary edges that lie
+/// on the inner side of the other edge. Returns whether any was added.
+fn add_penetrations(uv: &[Point2<f64>], boundary: &[VertexId], prob: &mut Problem) -> bool {
+    let delta = 1e-3 * prob.pen_margin;
+    let m = boundary.len();
+    let mut added = false;
+    let inside = penetrating_vertices(uv, boundary, delta);
+    for (e1, e2) in crossing_edges(uv, boundary) {
+        // Crossings with a penetrating endpoint are repaired through that vertex below; the
+        // rest are thin spikes crossing each other (no vertex inside the other's material).
+        if [e1, (e1 + 1) % m, e2, (e2 + 1) % m]
+            .iter()
+            .any(|k| inside.contains(k))
+        {
+            continue;
+        }
+        for (e, f) in [(e1, e2), (e2, e1)] {
+            let (a, b) = (boundary[f].idx(), boundary[(f + 1) % m].idx());
+            for k in [e, (e + 1) % m] {
+                let p = boundary[k].idx();
+                let pair = [p, a, b];
+                if signed_gap(uv, p, a, b).is_some_and(|(sd, _)| sd > 0.0)
+                    && !prob.pen_pairs.contains(&pair)
+                {
+                    prob.pen_pairs.push(pair);
+                    added = true;
+                }
+            }
+        }
+    }
+    for k in inside {
+        let p = boundary[k].idx();
+        if prob.pen_pairs.iter().any(|q| q[0] == p) {
+            continue;
+        }
+        if let Some(e) = edge_to_leave(uv, boundary, k) {
+            let m = boundary.len();
+            prob.pen_pairs
+                .push([p, boundary[e].idx(), boundary[(e + 1) % m].idx()]);
+            added = true;
+        }
+    }
+    added
+}
+
 /// Minimise the symmetric Dirichlet energy of the certified map `uv0` of `disk` (free
 /// boundary, projected Newton, boundary barrier, certified line search; see the module
 /// docs). Returns the last accepted iterate, which passes `certify_bijective`, and the log.
@@ -610,6 +1010,36 @@ pub fn optimize_with_log(
     options: &SdOptions,
 ) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
     certify(disk, uv0, boundary)?;
+    newton(disk, boundary, uv0, options, true, &OnceCell::new())
+}
+
+/// [`optimize_with_log`] without the global part: locally injective projected Newton (no
+/// barrier, no collision bound, no certificate; triangles stay float-positive), with the
+/// overlap-repair penalty when `options.repair_weight > 0` (see `SdOptions::repair_iters`;
+/// then it stops once the map is certified). The result may still overlap itself.
+/// Errors: `NotCertified` if a triangle of `uv0` is not float-positive.
+pub fn optimize_locally_injective(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    uv0: &[Point2<f64>],
+    options: &SdOptions,
+) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
+    newton(disk, boundary, uv0, options, false, &OnceCell::new())
+}
+
+/// Projected Newton on the symmetric Dirichlet energy. `certified`: the full method of the
+/// module docs (barrier, collision bound, every iterate certified); otherwise only locally
+/// injective (float-positive triangles via a finite energy; no barrier, no collision bound,
+/// no certificate) — the LSCM repair of [`initial_map`], whose result is certified by the
+/// caller before it is used.
+fn newton(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    uv0: &[Point2<f64>],
+    options: &SdOptions,
+    certified: bool,
+    setup: &OnceCell<Setup>,
+) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
     let n = disk.n_vertices();
     let frames = triangle_frames(disk);
     let total_area: f64 = frames.iter().map(|f| f.area).sum();
@@ -621,13 +1051,24 @@ pub fn optimize_with_log(
             .push(min_double_area(&uv, &disk.triangles));
         return Ok((uv, log));
     }
-    let prob = Problem {
+    let mut prob = Problem {
         tris: &disk.triangles,
         frames,
         boundary,
         total_area,
-        eps: options.barrier_distance * disk.mean_edge_length(),
+        eps: if certified {
+            options.barrier_distance * disk.mean_edge_length()
+        } else {
+            0.0
+        },
         barrier_w: options.barrier_weight / disk.n_faces() as f64,
+        pen_w: if certified {
+            0.0
+        } else {
+            options.repair_weight / disk.n_faces() as f64
+        },
+        pen_margin: options.repair_margin * disk.mean_edge_length(),
+        pen_pairs: Vec::new(),
     };
     let clock = std::time::Instant::now();
     let mut lap = {
@@ -639,24 +1080,9 @@ pub fn optimize_with_log(
             dt
         }
     };
-    let pat = Pattern::new(n, &disk.triangles);
+    let Setup { pat, symbolic } = Setup::get(setup, disk)?;
     let dim = 2 * n;
     let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
-    // One symbolic factorisation (AMD ordering) for all iterations. Sequential (`Par::Seq`):
-    // the result must not depend on the thread count (same seed → same bytes), and small
-    // factorisations gain little from threads.
-    let symbolic = factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), {
-        // Supernodal from SUPERNODAL_MIN_DIM dofs: faer's automatic choice picks the
-        // simplicial kernel for these 2D-mesh Hessians, measured ~25–50% slower per
-        // factorisation on 5k–15k-face cover patches (the 2×2 vertex blocks make dense
-        // supernodes); small patches keep the automatic choice.
-        let mut p = CholeskySymbolicParams::default();
-        if dim >= SUPERNODAL_MIN_DIM {
-            p.supernodal_flop_ratio_threshold = SupernodalThreshold::FORCE_SUPERNODAL;
-        }
-        p
-    })
-    .map_err(|e| ParamError::Solver(format!("symbolic Cholesky: {e:?}")))?;
     let mut l_values = vec![0.0; symbolic.len_val()];
     let mut mem = MemBuffer::new(
         symbolic
@@ -667,7 +1093,15 @@ pub fn optimize_with_log(
     log.time_ms[0] += lap();
     let mut vals = vec![0.0; pat.row_idx.len()];
     let mut grad = vec![0.0; dim];
+    if prob.pen_w > 0.0 {
+        add_penetrations(&uv, boundary, &mut prob);
+    }
     let mut energy = prob.energy(&uv);
+    if !certified && !energy.is_finite() {
+        return Err(ParamError::NotCertified(
+            "the start has a flipped or degenerate triangle".to_string(),
+        ));
+    }
     log.energies.push(energy);
     log.min_double_area
         .push(min_double_area(&uv, &disk.triangles));
@@ -675,72 +1109,126 @@ pub fn optimize_with_log(
     let mut abs_twist = false;
     let mut trial = uv.clone();
     let mut probe = uv.clone();
+    let (mut fewest_crossings, mut stalled) = (usize::MAX, 0);
     while log.iterations < options.max_iters {
         lap();
-        prob.assemble(&uv, &pat, &mut grad, &mut vals, abs_twist)?;
+        prob.assemble(&uv, pat, &mut grad, &mut vals, abs_twist)?;
         log.time_ms[1] += lap();
         // Regularise the projected Hessian (translations and, at an isometry, rotations are
         // in its null space); grow the shift until the Cholesky factorisation succeeds.
         let trace: f64 = (0..dim)
             .map(|v| vals[pat.diag_slots[v / 2][if v % 2 == 0 { 0 } else { 3 }] as usize])
             .sum();
-        let mut mu = 1e-8 * trace / dim as f64;
-        let mut sol = Mat::<f64>::zeros(dim, 1);
-        let mut factored = false;
-        for _ in 0..8 {
-            shifted.copy_from_slice(&vals);
-            for vv in 0..n {
-                shifted[pat.diag_slots[vv][0] as usize] += mu;
-                shifted[pat.diag_slots[vv][3] as usize] += mu;
-            }
-            let mat = SparseColMatRef::new(sym, &shifted);
-            log.factorizations += 1;
-            if let Ok(llt) = symbolic.factorize_numeric_llt::<f64>(
-                &mut l_values,
-                mat,
-                Side::Lower,
-                Default::default(),
-                Par::Seq,
-                MemStack::new(&mut mem),
-                Default::default(),
-            ) {
-                for i in 0..dim {
-                    sol[(i, 0)] = -grad[i];
+        let mean_diag = trace / dim as f64;
+        // Newton direction for the Hessian plus `kappa · n nᵀ` on the 2×2 blocks of the
+        // vertices of every listed (vertex, edge) pair, `n` the edge normal.
+        let mut solve = |pairs: &[[usize; 3]], log: &mut SdLog| -> Result<Vec<f64>, ParamError> {
+            let mut mu = 1e-8 * mean_diag;
+            let kappa = options.collision_stiffness * mean_diag;
+            for _ in 0..8 {
+                shifted.copy_from_slice(&vals);
+                for vv in 0..n {
+                    shifted[pat.diag_slots[vv][0] as usize] += mu;
+                    shifted[pat.diag_slots[vv][3] as usize] += mu;
                 }
-                llt.solve_in_place_with_conj(
-                    Conj::No,
-                    sol.as_mut(),
+                for &[p, a, b] in pairs {
+                    let e = uv[b] - uv[a];
+                    let l = e.norm();
+                    if l <= 0.0 {
+                        continue;
+                    }
+                    let nn = Vector2::new(-e.y, e.x) / l;
+                    for v in [p, a, b] {
+                        let s = &pat.diag_slots[v];
+                        shifted[s[0] as usize] += kappa * nn.x * nn.x;
+                        shifted[s[1] as usize] += kappa * nn.y * nn.x;
+                        shifted[s[2] as usize] += kappa * nn.x * nn.y;
+                        shifted[s[3] as usize] += kappa * nn.y * nn.y;
+                    }
+                }
+                let mat = SparseColMatRef::new(sym, &shifted);
+                log.factorizations += 1;
+                if let Ok(llt) = symbolic.factorize_numeric_llt::<f64>(
+                    &mut l_values,
+                    mat,
+                    Side::Lower,
+                    Default::default(),
                     Par::Seq,
                     MemStack::new(&mut mem),
-                );
-                factored = true;
-                break;
+                    Default::default(),
+                ) {
+                    let mut sol = Mat::<f64>::zeros(dim, 1);
+                    for i in 0..dim {
+                        sol[(i, 0)] = -grad[i];
+                    }
+                    llt.solve_in_place_with_conj(
+                        Conj::No,
+                        sol.as_mut(),
+                        Par::Seq,
+                        MemStack::new(&mut mem),
+                    );
+                    return Ok((0..dim).map(|i| sol[(i, 0)]).collect());
+                }
+                mu *= 100.0;
             }
-            mu *= 100.0;
-        }
-        if !factored {
-            return Err(ParamError::Solver(
+            Err(ParamError::Solver(
                 "Newton Hessian is not positive definite".to_string(),
-            ));
-        }
-        let dir: Vec<f64> = (0..dim).map(|i| sol[(i, 0)]).collect();
-        let slope: f64 = dir.iter().zip(&grad).map(|(d, g)| d * g).sum();
+            ))
+        };
+        let mut dir = solve(&[], &mut log)?;
+        let mut slope: f64 = dir.iter().zip(&grad).map(|(d, g)| d * g).sum();
         log.time_ms[2] += lap();
         // NaN-safe: a NaN slope also means no usable descent direction.
         if slope.is_nan() || slope >= 0.0 {
             converged = true; // no descent direction left
             break;
         }
-        let t_flip = prob.max_flip_free_step(&uv, &dir);
-        let t_safe = options.step_fraction * t_flip;
+        let mut t_flip = prob.max_flip_free_step(&uv, &dir);
         // Boundary-collision bound over the steps the first trial can reach (the
         // extrapolation beyond it is judged by the certificate alone).
-        let horizon = t_flip.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
-        let t_coll = if options.collision_bound {
-            max_collision_free_step(&uv, &dir, boundary, horizon)
-        } else {
-            horizon
-        };
+        let mut horizon = t_flip.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
+        let mut t_coll = horizon;
+        // Not in the overlap repair: resolving an overlap moves vertices across edges.
+        if options.collision_bound && certified {
+            let mut pairs = Vec::new();
+            t_coll = collisions(&uv, &dir, boundary, horizon, &mut pairs);
+            // Active set: the step is cut short by boundary vertices about to hit boundary
+            // edges; stiffen the Hessian against their motion along the edge normal (a PSD
+            // term, so the new direction is still a descent direction) and re-solve, so that
+            // one colliding pair no longer shortens the step of the whole map.
+            let mut rounds = 0;
+            while t_coll < options.collision_active_below * horizon
+                && rounds < options.collision_rounds
+            {
+                rounds += 1;
+                let d2 = solve(&pairs, &mut log)?;
+                let s2: f64 = d2.iter().zip(&grad).map(|(d, g)| d * g).sum();
+                if s2.is_nan() || s2 >= 0.0 {
+                    break;
+                }
+                let f2 = prob.max_flip_free_step(&uv, &d2);
+                let h2 = f2.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
+                let mut more = Vec::new();
+                let c2 = collisions(&uv, &d2, boundary, h2, &mut more);
+                // Keep the new direction only if it predicts more decrease within its bound.
+                let gain = |s: f64, t: f64| -s * t.min(1.0);
+                if gain(s2, c2) <= gain(slope, t_coll) {
+                    break;
+                }
+                dir = d2;
+                slope = s2;
+                t_flip = f2;
+                horizon = h2;
+                t_coll = c2;
+                for p in more {
+                    if !pairs.contains(&p) {
+                        pairs.push(p);
+                    }
+                }
+            }
+            log.time_ms[2] += lap();
+        }
+        let t_safe = options.step_fraction * t_flip;
         if t_coll < horizon {
             log.collision_limited += 1;
         }
@@ -752,7 +1240,7 @@ pub fn optimize_with_log(
             }
             let e = prob.energy(&trial);
             if e <= energy + options.armijo * t * slope {
-                if recertify(disk, &trial, boundary).is_ok() {
+                if !certified || recertify(disk, &trial, boundary).is_ok() {
                     accepted = Some(e);
                     break;
                 }
@@ -775,7 +1263,10 @@ pub fn optimize_with_log(
                     );
                 }
                 let e = prob.energy(&probe);
-                if e.is_nan() || e >= e_best || recertify(disk, &probe, boundary).is_err() {
+                if e.is_nan()
+                    || e >= e_best
+                    || (certified && recertify(disk, &probe, boundary).is_err())
+                {
                     break;
                 }
                 e_best = e;
@@ -808,6 +1299,33 @@ pub fn optimize_with_log(
         // relative to E itself the constant 4 would stop developable patches early.
         let rel = (energy - e_new) / (energy - 4.0).max(f64::MIN_POSITIVE);
         energy = e_new;
+        if !certified && prob.pen_w > 0.0 {
+            // Overlap repair: done once the map is certified with every repaired vertex at
+            // least half the clearance outside; else add the newly penetrating vertices.
+            let clear = prob.pen_pairs.iter().all(|&[p, a, b]| {
+                signed_gap(&uv, p, a, b).is_none_or(|(sd, _)| sd <= -0.5 * prob.pen_margin)
+            });
+            if clear && recertify(disk, &uv, boundary).is_ok() {
+                converged = true;
+                break;
+            }
+            // Give up early when the number of crossing boundary edges stops falling: the
+            // caller then starts from the Tutte map, and every repair step is time lost.
+            let crossings = crossing_edges(&uv, boundary).len();
+            if crossings < fewest_crossings {
+                fewest_crossings = crossings;
+                stalled = 0;
+            } else {
+                stalled += 1;
+                if stalled >= REPAIR_PATIENCE {
+                    break;
+                }
+            }
+            if add_penetrations(&uv, boundary, &mut prob) {
+                energy = prob.energy(&uv);
+                continue;
+            }
+        }
         if rel < options.rel_tol {
             converged = true;
             break;
@@ -822,6 +1340,9 @@ pub fn optimize_with_log(
 pub enum InitialMap {
     /// The free-boundary LSCM passed the certificate.
     Lscm,
+    /// The overlapping LSCM after the overlap repair (`repair_iters`: locally injective
+    /// symmetric Dirichlet steps with a penetration penalty) passed the certificate.
+    RepairedLscm,
     /// Tutte map onto the ellipse of the (overlapping) LSCM boundary.
     EllipseTutte,
     /// Tutte map onto a circle (the certified fallback).
@@ -829,7 +1350,8 @@ pub enum InitialMap {
 }
 
 /// The certified initial map of [`SymmetricDirichlet`], scaled to the 3D area: the LSCM if
-/// it passes the exact certificate; else (`shaped_tutte_init`) the Tutte map onto the
+/// it passes the exact certificate; else (`repair_iters > 0`) the repaired LSCM if it
+/// passes; else (`shaped_tutte_init`) the Tutte map onto the
 /// ellipse of the LSCM boundary ([`super::ellipse_boundary`], strictly convex, so Tutte's
 /// theorem applies) if it passes; else the circle Tutte map (`init_weights`, then uniform).
 pub fn initial_map(
@@ -837,11 +1359,34 @@ pub fn initial_map(
     boundary: &[VertexId],
     options: &SdOptions,
 ) -> Result<(Vec<Point2<f64>>, InitialMap), ParamError> {
+    initial_map_with(disk, boundary, options, &OnceCell::new())
+}
+
+/// [`initial_map`] with the Newton setup shared with the optimisation that follows.
+fn initial_map_with(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    options: &SdOptions,
+    setup: &OnceCell<Setup>,
+) -> Result<(Vec<Point2<f64>>, InitialMap), ParamError> {
     if options.free_boundary_init {
-        if let Ok(mut uv) = super::lscm(disk, boundary) {
+        let lscm = Setup::get(setup, disk).and_then(|s| lscm_shared(disk, boundary, s));
+        if let Ok(mut uv) = lscm {
             scale_to_area(disk, &mut uv);
             if certify(disk, &uv, boundary).is_ok() {
                 return Ok((uv, InitialMap::Lscm));
+            }
+            if options.repair_iters > 0 {
+                let o = SdOptions {
+                    max_iters: options.repair_iters,
+                    ..*options
+                };
+                if let Ok((mut r, _)) = newton(disk, boundary, &uv, &o, false, setup) {
+                    scale_to_area(disk, &mut r);
+                    if certify(disk, &r, boundary).is_ok() {
+                        return Ok((r, InitialMap::RepairedLscm));
+                    }
+                }
             }
             if options.shaped_tutte_init {
                 if let Some(shape) = super::ellipse_boundary(disk, boundary, &uv) {
@@ -874,10 +1419,12 @@ impl Parameterizer for SymmetricDirichlet {
         boundary: &[VertexId],
     ) -> Result<Parameterization, ParamError> {
         validate_disk(disk, boundary)?;
-        let (uv0, _) = initial_map(disk, boundary, &self.options)?;
+        let setup = OnceCell::new();
+        let (uv0, _) = initial_map_with(disk, boundary, &self.options, &setup)?;
         // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
         // finite float energy, or a failed factorisation), the certified Tutte map is returned.
-        let (mut uv, log) = match optimize_with_log(disk, boundary, &uv0, &self.options) {
+        // `initial_map_with` certified `uv0`.
+        let (mut uv, log) = match newton(disk, boundary, &uv0, &self.options, true, &setup) {
             Ok(r) => r,
             Err(_) => (
                 uv0,
@@ -1017,6 +1564,59 @@ mod tests {
         dir[7] = 0.0;
         dir[0] = -1.0; // v0 moves left along the x axis: the line of edge (1,2) is x = 2
         assert_eq!(max_collision_free_step(&uv, &dir, &boundary, 5.0), 5.0);
+    }
+
+    #[test]
+    fn overlap_detection_finds_the_vertex_pushed_into_the_other_arm() {
+        // A "U" (counter-clockwise): arms x ∈ [0, 1] and x ∈ [2, 3] above y = 1.
+        let mut uv = vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(3.0, 0.0),
+            Point2::new(3.0, 3.0),
+            Point2::new(2.0, 3.0),
+            Point2::new(2.0, 1.0),
+            Point2::new(1.0, 1.0),
+            Point2::new(1.0, 3.0),
+            Point2::new(0.0, 3.0),
+        ];
+        let boundary: Vec<VertexId> = (0..8).map(VertexId::new).collect();
+        assert!(penetrating_vertices(&uv, &boundary, 1e-6).is_empty());
+        assert!(crossing_edges(&uv, &boundary).is_empty());
+        // The right arm's top-left corner pushed across the slit into the left arm.
+        uv[3] = Point2::new(0.5, 2.5);
+        let inside = penetrating_vertices(&uv, &boundary, 1e-6);
+        assert!(inside.contains(&3), "{inside:?}");
+        assert!(!inside.contains(&0) && !inside.contains(&1), "{inside:?}");
+        let mut crossings: Vec<(usize, usize)> = crossing_edges(&uv, &boundary)
+            .into_iter()
+            .map(|(a, b)| (a.min(b), a.max(b)))
+            .collect();
+        crossings.sort_unstable();
+        assert_eq!(crossings, vec![(2, 5), (3, 5)]);
+        // The edge it has to leave is the left arm's inner side (5, 6), and the repair term
+        // pushes it back out: its signed gap is positive (inside) now.
+        assert_eq!(edge_to_leave(&uv, &boundary, 3), Some(5));
+        let (sd, (n, _)) = signed_gap(&uv, 3, 5, 6).unwrap();
+        assert!((sd - 0.5).abs() < 1e-12, "{sd}");
+        assert!((n - Vector2::new(-1.0, 0.0)).norm() < 1e-12, "{n}");
+    }
+
+    #[test]
+    fn shared_lscm_equals_the_public_lscm() {
+        let mut disk = crate::mesh::generators::cylinder_piece(1.0, 2.0, 1.0, 8, 3);
+        // Bend it a little more so the map is not a plain unrolling.
+        for p in &mut disk.positions {
+            p.z += 0.1 * p.x * p.y;
+        }
+        let boundary = super::super::disk_boundary(&disk).unwrap();
+        let a = super::super::lscm(&disk, &boundary).unwrap();
+        let b = lscm_shared(&disk, &boundary, &Setup::new(&disk).unwrap()).unwrap();
+        let err = a
+            .iter()
+            .zip(&b)
+            .map(|(p, q)| (p - q).norm())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-9, "{err}");
     }
 
     #[test]
