@@ -200,8 +200,12 @@ pub struct Certificate {
     pub disk: usize,
     /// Parameterizations certified bijective (exact orient2d, simple boundary).
     pub bijective: usize,
-    /// Planar remeshes certified (positive, same boundary, disk).
+    /// Planar remeshes certified (positive, same boundary, disk): the first remesh of each
+    /// attempt.
     pub planar: usize,
+    /// The fidelity control's further planar remeshes of an attempt, each certified like
+    /// `planar`.
+    pub planar_refined: usize,
     /// Working mesh edge- and vertex-manifold after the patch.
     pub manifold: usize,
     /// Working mesh consistently oriented after the patch.
@@ -824,7 +828,11 @@ fn remesh_patch(
             .map_err(|e| Failure::stage("planar remeshing", e))?;
         invariants::certify_planar(&domain, &planar)
             .map_err(|e| Failure::certificate("planar remeshing", e))?;
-        cert.planar += 1;
+        if rounds == 0 {
+            cert.planar += 1;
+        } else {
+            cert.planar_refined += 1;
+        }
         times.remesh2d += t0.elapsed().as_secs_f64();
 
         let t0 = Instant::now();
