@@ -14,11 +14,12 @@
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
 use crate::metric::MetricField;
+use crate::quality::parry_trimesh;
 use crate::remesh2d::{PlanarMesh, PlanarMetricField};
 use nalgebra::{Matrix2, Point2, Point3, Vector3};
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::PointQueryWithLocation;
-use parry3d_f64::shape::{TriMesh as PTriMesh, TrianglePointLocation};
+use parry3d_f64::shape::TrianglePointLocation;
 use serde::Serialize;
 
 /// Options of the fidelity control.
@@ -31,14 +32,19 @@ pub struct FidelityOptions {
     pub rounds: usize,
     /// Largest factor by which one round scales a vertex tensor.
     pub max_factor: f64,
+    /// No scaling makes the metric's shortest edge shorter than this fraction of the input's
+    /// mean edge length: the input is piecewise linear, and triangles much finer than its
+    /// own follow it no better (on a flat plate with sharp rims they only multiply).
+    pub min_edge_ratio: f64,
 }
 
 impl Default for FidelityOptions {
     fn default() -> Self {
         FidelityOptions {
-            max_deviation: 0.0045,
+            max_deviation: 0.0035,
             rounds: 2,
             max_factor: 16.0,
+            min_edge_ratio: 0.5,
         }
     }
 }
@@ -128,14 +134,9 @@ pub fn deviations(
     }
 
     // reference → patch
-    let verts: Vec<PVec> = patch
-        .positions
-        .iter()
-        .map(|q| PVec::new(q.x, q.y, q.z))
-        .collect();
-    if let (Some((lo, hi)), Ok(bvh)) = (
+    if let (Some((lo, hi)), Some(bvh)) = (
         bbox(patch.positions),
-        PTriMesh::new(verts, patch.triangles.to_vec()),
+        parry_trimesh(patch.positions, patch.triangles.to_vec()),
     ) {
         let grow = Vector3::repeat(longest);
         let mut ref_vertices: Vec<VertexId> = field
@@ -210,8 +211,8 @@ fn bbox(points: &[Point3<f64>]) -> Option<(Point3<f64>, Point3<f64>)> {
 /// triangle (its corners and centroid, located exactly) get the factor `(d/eps)²` (the
 /// distance of a cut-off tip or crease shrinks linearly with the edge length, a smooth
 /// sagitta quadratically; the square covers both), capped at `max_factor`; their neighbours
-/// in the initial mesh get its square root, a one-ring gradation. Returns how many tensors
-/// were scaled.
+/// in the initial mesh get its square root, a one-ring gradation. No tensor is scaled beyond
+/// a shortest edge `l_tar/√λ_max` of `min_edge`. Returns how many tensors were scaled.
 pub fn scale_metric(
     metrics: &mut [Matrix2<f64>],
     field: &PlanarMetricField,
@@ -219,6 +220,8 @@ pub fn scale_metric(
     deviating: &[(usize, f64)],
     eps: f64,
     max_factor: f64,
+    l_tar: f64,
+    min_edge: f64,
 ) -> usize {
     let mut factor = vec![1.0f64; metrics.len()];
     let init = field.triangles();
@@ -246,8 +249,12 @@ pub fn scale_metric(
             graded[v as usize] = graded[v as usize].max(m.sqrt());
         }
     }
+    // Cap: the scaled tensor's shortest edge l_tar/√λ_max stays ≥ min_edge.
+    let lmax_allowed = (l_tar / min_edge).powi(2);
     let mut n = 0;
     for (m, f) in metrics.iter_mut().zip(graded) {
+        let lmax = m.symmetric_eigenvalues().max();
+        let f = f.min(lmax_allowed / lmax);
         if f > 1.0 {
             *m *= f;
             n += 1;
@@ -269,8 +276,9 @@ pub fn scale_metric(
 /// radius `r = l_tar/√λ_max(M(v))` (the metric's shortest edge, at most 5 % of the
 /// diagonal; at most 400 vertices) and below the height bound; the factor is `(r / d)²` (at
 /// most 25) for the distance `d` of the nearest point, on the edges leaving the walked
-/// vertices, where the surface rises above `4·eps`, i.e. the ball shrinks until it excludes
-/// it. Factors are then graded so that neighbours
+/// vertices towards a vertex whose normal is within 60° of `v`'s, where the surface rises
+/// above `4·eps`, i.e. the ball shrinks until it excludes
+/// it; never beyond the factor that would make the shortest edge shorter than `min_edge`. Factors are then graded so that neighbours
 /// differ by at most `grade²` (a size ratio of `grade` per edge).
 pub fn a_priori_scale(
     reference: &TriMesh,
@@ -278,6 +286,7 @@ pub fn a_priori_scale(
     metrics: &[nalgebra::Matrix3<f64>],
     l_tar: f64,
     eps: f64,
+    min_edge: f64,
 ) -> Vec<f64> {
     use rayon::prelude::*;
     const MAX_VISIT: usize = 400;
@@ -321,7 +330,12 @@ pub fn a_priori_scale(
                 for w in topo.vertex_neighbors(u) {
                     let dw = reference.positions[w.idx()] - x0;
                     let hw = dw.dot(&nv);
-                    if hw.abs() > height_max {
+                    // Only where the surface still faces v's way (normals within 60°): past a
+                    // crease the surface turns away, and triangles that end on the crease
+                    // follow it exactly, so it is no reason to refine v.
+                    let nw = normals[w.idx()];
+                    let facing = nw.dot(&nv) >= 0.5 * nw.norm();
+                    if hw.abs() > height_max && facing {
                         let target = height_max.copysign(hw);
                         let t = ((target - hu) / (hw - hu)).clamp(0.0, 1.0);
                         let d = (du + (dw - du) * t).norm();
@@ -337,7 +351,8 @@ pub fn a_priori_scale(
                 }
             }
             if nearest_high.is_finite() && nearest_high > 0.0 {
-                return (radius / nearest_high).powi(2).min(MAX_FACTOR);
+                let cap = (radius / min_edge).powi(2).clamp(1.0, MAX_FACTOR);
+                return (radius / nearest_high).powi(2).min(cap);
             }
             1.0
         })
@@ -387,17 +402,12 @@ pub fn patch_vertex_factors(field: &MetricField, scale: &[f64], patch: &TriMesh)
     }
     high.sort_unstable();
     high.dedup();
-    let verts: Vec<PVec> = patch
-        .positions
-        .iter()
-        .map(|q| PVec::new(q.x, q.y, q.z))
-        .collect();
     let tris: Vec<[u32; 3]> = patch
         .triangles
         .iter()
         .map(|t| [t[0].0, t[1].0, t[2].0])
         .collect();
-    let Ok(bvh) = PTriMesh::new(verts, tris) else {
+    let Some(bvh) = parry_trimesh(&patch.positions, tris) else {
         return out;
     };
     for r in high {
@@ -457,9 +467,9 @@ mod tests {
         // Over the ball of radius ℓ = L/√k (< 0.05, the cap) the sphere rises k ℓ²/2 = L²/2
         // above a tangent plane: with L = 0.09 that is 0.00405, below 4·eps for eps = 0.002
         // and above it for eps = 0.0008.
-        let fine = a_priori_scale(&m, &topo, f.vertex_metrics(), 0.09, 0.002);
+        let fine = a_priori_scale(&m, &topo, f.vertex_metrics(), 0.09, 0.002, 1e-6);
         assert!(fine.iter().all(|&s| s == 1.0));
-        let coarse = a_priori_scale(&m, &topo, f.vertex_metrics(), 0.09, 0.0008);
+        let coarse = a_priori_scale(&m, &topo, f.vertex_metrics(), 0.09, 0.0008, 1e-6);
         assert!(coarse.iter().all(|&s| s > 1.0));
     }
 
@@ -468,7 +478,7 @@ mod tests {
         let m = Normalization::of(&tent(0.3)).apply(&tent(0.3));
         let f = field(&m);
         let topo = Topology::build(&m);
-        let s = a_priori_scale(&m, &topo, f.vertex_metrics(), 0.3, 0.005);
+        let s = a_priori_scale(&m, &topo, f.vertex_metrics(), 0.3, 0.005, 1e-6);
         let apex = (0..m.n_vertices())
             .max_by(|&a, &b| m.positions[a].z.total_cmp(&m.positions[b].z))
             .expect("vertices");

@@ -357,6 +357,7 @@ pub fn remesh(
     // metric, as is every quality measure.
     let scaled_field;
     let mut fid_scale: Vec<f64> = Vec::new();
+    let min_edge = options.fidelity.min_edge_ratio * mean_edge_length(reference);
     let field = if options.fidelity.max_deviation > 0.0 {
         let topo = Topology::build(reference);
         let s = fidelity::a_priori_scale(
@@ -365,6 +366,7 @@ pub fn remesh(
             field.vertex_metrics(),
             l_tar,
             options.fidelity.max_deviation,
+            min_edge,
         );
         let metrics = field
             .vertex_metrics()
@@ -487,6 +489,7 @@ pub fn remesh(
                 &flip_test,
                 &ref_normals,
                 &fid_scale,
+                min_edge,
                 embedded_input,
                 &faces,
                 l_tar,
@@ -737,6 +740,7 @@ fn remesh_patch(
     flip_test: &FlipTest,
     ref_normals: &[Vector3<f64>],
     fid_scale: &[f64],
+    min_edge: f64,
     embedded_input: bool,
     faces: &[FaceId],
     l_tar: f64,
@@ -884,6 +888,8 @@ fn remesh_patch(
                 &deviating,
                 eps,
                 options.fidelity.max_factor,
+                l_tar,
+                min_edge,
             )
         };
         times.fidelity += t0.elapsed().as_secs_f64();
@@ -916,6 +922,19 @@ fn remesh_patch(
         cert.locally_embedded += 1;
     }
     Ok((replacement, param.report, rounds))
+}
+
+/// Mean length of the edges of `mesh` (each interior edge counted from both faces).
+fn mean_edge_length(mesh: &TriMesh) -> f64 {
+    let (sum, n) = mesh.faces().fold((0.0, 0usize), |(s, n), f| {
+        let [a, b, c] = mesh.face_points(f);
+        (s + (b - a).norm() + (c - b).norm() + (a - c).norm(), n + 3)
+    });
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
 }
 
 /// A smaller disk inside `faces`: grown face by face (breadth first, exact disk rule) from

@@ -133,15 +133,20 @@ pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, P
             }
         }
     }
-    if let Some(v) = uv
+    finite_lscm(uv)
+}
+
+/// `uv` if every position is finite, else an error naming the first vertex that is not.
+pub(crate) fn finite_lscm(uv: Vec<Point2<f64>>) -> Result<Vec<Point2<f64>>, ParamError> {
+    match uv
         .iter()
         .position(|p| !(p.x.is_finite() && p.y.is_finite()))
     {
-        return Err(ParamError::Solver(format!(
+        Some(v) => Err(ParamError::Solver(format!(
             "LSCM gave a non-finite position for v{v}"
-        )));
+        ))),
+        None => Ok(uv),
     }
-    Ok(uv)
 }
 
 /// Solve `a x = rhs` (symmetric positive definite, full storage) by sparse Cholesky; the

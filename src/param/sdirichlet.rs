@@ -356,15 +356,7 @@ fn lscm_shared(
     let uv: Vec<Point2<f64>> = (0..n)
         .map(|v| Point2::new(sol[(2 * v, 0)], sol[(2 * v + 1, 0)]))
         .collect();
-    if let Some(v) = uv
-        .iter()
-        .position(|p| !(p.x.is_finite() && p.y.is_finite()))
-    {
-        return Err(ParamError::Solver(format!(
-            "LSCM gave a non-finite position for v{v}"
-        )));
-    }
-    Ok(uv)
+    super::lscm::finite_lscm(uv)
 }
 
 /// Energy, gradient and projected Hessian of one triangle with respect to `vec(F)`

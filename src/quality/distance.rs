@@ -21,22 +21,14 @@ impl SurfaceProjector {
     /// Index the triangles of `mesh`. A mesh without faces gives a projector that finds
     /// nothing.
     pub fn new(mesh: &TriMesh) -> Self {
-        let vertices: Vec<PVec> = mesh
-            .positions
-            .iter()
-            .map(|p| PVec::new(p.x, p.y, p.z))
-            .collect();
         let indices: Vec<[u32; 3]> = mesh
             .triangles
             .iter()
             .map(|t| [t[0].0, t[1].0, t[2].0])
             .collect();
-        let bvh = if indices.is_empty() {
-            None
-        } else {
-            PTriMesh::new(vertices, indices).ok()
-        };
-        SurfaceProjector { bvh }
+        SurfaceProjector {
+            bvh: parry_trimesh(&mesh.positions, indices),
+        }
     }
 
     /// The closest point of the surface to `p`, the face it lies on, and the distance.
@@ -52,6 +44,19 @@ impl SurfaceProjector {
         let c = Point3::new(proj.point.x, proj.point.y, proj.point.z);
         Some((FaceId(tri), c, (c - p).norm()))
     }
+}
+
+/// parry's triangle mesh (with its BVH) over `positions` and `triangles`; `None` without
+/// triangles or when parry refuses them.
+pub(crate) fn parry_trimesh(
+    positions: &[Point3<f64>],
+    triangles: Vec<[u32; 3]>,
+) -> Option<PTriMesh> {
+    if triangles.is_empty() {
+        return None;
+    }
+    let vertices: Vec<PVec> = positions.iter().map(|p| PVec::new(p.x, p.y, p.z)).collect();
+    PTriMesh::new(vertices, triangles).ok()
 }
 
 /// Two-sided approximation error between two surfaces.

@@ -11,6 +11,7 @@
 mod distance;
 mod eval;
 
+pub(crate) use distance::parry_trimesh;
 pub use distance::{approximation_error, flips, Distance, FlipTest, SurfaceProjector};
 pub use eval::{evaluate, EvalOptions, EvalReport, EvalTimings, MeshSize, TargetLength};
 
