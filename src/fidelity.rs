@@ -213,6 +213,7 @@ fn bbox(points: &[Point3<f64>]) -> Option<(Point3<f64>, Point3<f64>)> {
 /// sagitta quadratically; the square covers both), capped at `max_factor`; their neighbours
 /// in the initial mesh get its square root, a one-ring gradation. No tensor is scaled beyond
 /// a shortest edge `l_tar/√λ_max` of `min_edge`. Returns how many tensors were scaled.
+#[allow(clippy::too_many_arguments)]
 pub fn scale_metric(
     metrics: &mut [Matrix2<f64>],
     field: &PlanarMetricField,
