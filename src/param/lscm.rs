@@ -10,7 +10,9 @@ use super::ParamError;
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky,
+};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
 use faer::{Conj, Mat, Par, Side};
@@ -165,6 +167,17 @@ fn cholesky_solve(
     let symbolic =
         factorize_symbolic_cholesky(a.symbolic(), Side::Lower, Default::default(), params)
             .map_err(|e| err("symbolic Cholesky", &e))?;
+    llt_solve(&symbolic, a, &mut rhs)?;
+    Ok(rhs)
+}
+
+/// Numeric Cholesky of `a` on its symbolic factorisation, then `rhs ← a⁻¹ rhs` (the LSCM
+/// solve; also used by the symmetric Dirichlet setup, which keeps one symbolic factorisation).
+pub(crate) fn llt_solve(
+    symbolic: &SymbolicCholesky<usize>,
+    a: SparseColMatRef<'_, usize, f64>,
+    rhs: &mut Mat<f64>,
+) -> Result<(), ParamError> {
     let mut l_values = vec![0.0; symbolic.len_val()];
     let mut mem = MemBuffer::new(
         symbolic
@@ -181,9 +194,9 @@ fn cholesky_solve(
             MemStack::new(&mut mem),
             Default::default(),
         )
-        .map_err(|e| err("Cholesky", &e))?;
+        .map_err(|e| ParamError::Solver(format!("LSCM Cholesky: {e:?}")))?;
     llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), Par::Seq, MemStack::new(&mut mem));
-    Ok(rhs)
+    Ok(())
 }
 
 #[cfg(test)]

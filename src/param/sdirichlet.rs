@@ -334,25 +334,7 @@ fn lscm_shared(
         }
     }
     let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
-    let symbolic = &setup.symbolic;
-    let mut l_values = vec![0.0; symbolic.len_val()];
-    let mut mem = MemBuffer::new(
-        symbolic
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
-    );
-    let llt = symbolic
-        .factorize_numeric_llt::<f64>(
-            &mut l_values,
-            SparseColMatRef::new(sym, &vals),
-            Side::Lower,
-            Default::default(),
-            Par::Seq,
-            MemStack::new(&mut mem),
-            Default::default(),
-        )
-        .map_err(|e| ParamError::Solver(format!("LSCM Cholesky: {e:?}")))?;
-    llt.solve_in_place_with_conj(Conj::No, sol.as_mut(), Par::Seq, MemStack::new(&mut mem));
+    super::lscm::llt_solve(&setup.symbolic, SparseColMatRef::new(sym, &vals), &mut sol)?;
     let uv: Vec<Point2<f64>> = (0..n)
         .map(|v| Point2::new(sol[(2 * v, 0)], sol[(2 * v + 1, 0)]))
         .collect();
