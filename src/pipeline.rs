@@ -128,6 +128,10 @@ pub struct RemeshOptions {
     /// triangles deviate from the reference by more than `max_deviation` are remeshed again
     /// with the metric scaled up there.
     pub fidelity: FidelityOptions,
+    /// How many times Algorithm 1 covers the surface (our addition; 1 = the paper). Each
+    /// further sweep marks every face unprocessed and runs the loop again on the working
+    /// mesh, so the previous sweep's seams (fixed patch boundaries) are remeshed.
+    pub sweeps: usize,
 }
 
 impl Default for RemeshOptions {
@@ -141,6 +145,7 @@ impl Default for RemeshOptions {
             max_patches: None,
             strict: false,
             fidelity: FidelityOptions::default(),
+            sweeps: 1,
         }
     }
 }
@@ -264,6 +269,9 @@ pub struct RemeshResult {
     pub mesh: TriMesh,
     /// Reference location of every output vertex.
     pub locations: Vec<SurfaceLocation>,
+    /// Which patch produced each output face (`None`: an input face no patch replaced, i.e.
+    /// kept unchanged). Diagnostics: where the seams and kept faces are.
+    pub face_patch: Vec<Option<PatchId>>,
     /// What was done and certified.
     pub report: RemeshReport,
 }
@@ -391,6 +399,9 @@ pub fn remesh(
     };
     let embedded_input = options.check_self_intersections && input_pairs == 0;
     let mut work = WorkingMesh::from_reference(reference);
+    // Provenance of every working-mesh face, kept parallel to its triangles (`stitch` drops
+    // the patch's faces in order and appends the new ones).
+    let mut face_patch: Vec<Option<PatchId>> = vec![None; work.mesh.n_faces()];
     let ref_topo = Topology::build(reference);
     // The input must be an oriented 2-manifold (with boundary): say so up front, naming the
     // elements, rather than failing later inside a patch.
@@ -416,9 +427,18 @@ pub fn remesh(
     let mut n_patch = 0usize;
     let mut fallback = Fallbacks::default();
 
+    let mut sweep = 1usize;
     loop {
         if work.unprocessed() == 0 {
-            break;
+            if sweep >= options.sweeps {
+                break;
+            }
+            // A further sweep (our addition): every face is unprocessed again, so the new
+            // patches' fixed boundaries run through the previous sweep's remeshed faces
+            // (edges near L_tar) instead of the input's edges, and the previous seams end up
+            // inside new patches.
+            sweep += 1;
+            work.processed.iter_mut().for_each(|p| *p = false);
         }
         if let Some(max) = options.max_patches {
             if n_patch >= max {
@@ -506,6 +526,16 @@ pub fn remesh(
                         }
                     })?;
                     times.stitch += t0.elapsed().as_secs_f64();
+                    let mut gone = vec![false; face_patch.len()];
+                    for f in &faces {
+                        gone[f.idx()] = true;
+                    }
+                    let mut k = 0;
+                    face_patch.retain(|_| {
+                        k += 1;
+                        !gone[k - 1]
+                    });
+                    face_patch.resize(work.mesh.n_faces(), Some(pid));
                     break (
                         new_faces,
                         PatchRecord {
@@ -593,8 +623,8 @@ pub fn remesh(
         n_patch += 1;
         on_progress(Progress {
             patches: n_patch,
-            unprocessed: work.unprocessed(),
-            total,
+            unprocessed: work.unprocessed() + (options.sweeps.max(1) - sweep) * total,
+            total: total * options.sweeps.max(1),
         });
     }
 
@@ -644,6 +674,7 @@ pub fn remesh(
     Ok(RemeshResult {
         mesh: work.mesh,
         locations: work.locations,
+        face_patch,
         report,
     })
 }
