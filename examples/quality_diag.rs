@@ -62,6 +62,17 @@ fn main() {
         triangles: si_faces.iter().map(|f| unit.triangles[f.idx()]).collect(),
     };
     let si_proj = SurfaceProjector::new(&si_mesh);
+    if let Ok(path) = std::env::var("SI_DUMP") {
+        let txt: String = si_faces
+            .iter()
+            .map(|f| {
+                let [p, q, r] = unit.face_points(*f);
+                let c = (p.coords + q.coords + r.coords) / 3.0;
+                format!("{} {} {} {}\n", f.0, c.x, c.y, c.z)
+            })
+            .collect();
+        std::fs::write(path, txt).expect("dump");
+    }
     let retried: Vec<bool> = res
         .report
         .patch_records
@@ -138,6 +149,137 @@ fn main() {
             s.2 / s.0 as f64,
             s.3
         );
+    }
+    // Deficit by how much the metric varies across a face: the largest |log eigenvalue| of
+    // M_a^{-1/2} M_b M_a^{-1/2} over its vertex pairs (0: the same metric at all corners).
+    let variation = |f: usize| -> f64 {
+        let t = out.triangles[f];
+        let [p, q, r] = out.face_points(FaceId::new(f));
+        // An orthonormal basis of the face's plane: the metrics restricted to it (2×2).
+        let e1 = (q - p).normalize();
+        let n = (q - p).cross(&(r - p));
+        let e2 = n.cross(&e1).normalize();
+        let restrict = |m: &nalgebra::Matrix3<f64>| {
+            nalgebra::Matrix2::new(
+                e1.dot(&(m * e1)),
+                e1.dot(&(m * e2)),
+                e2.dot(&(m * e1)),
+                e2.dot(&(m * e2)),
+            )
+        };
+        let mut worst: f64 = 0.0;
+        for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+            let ma = restrict(&metrics[t[a].idx()]);
+            let mb = restrict(&metrics[t[b].idx()]);
+            let ea = nalgebra::SymmetricEigen::new(ma);
+            if ea.eigenvalues.iter().any(|x| *x <= 0.0) {
+                continue;
+            }
+            let ia = ea.eigenvectors
+                * nalgebra::Matrix2::from_diagonal(&ea.eigenvalues.map(|x| 1.0 / x.sqrt()))
+                * ea.eigenvectors.transpose();
+            let m = ia * mb * ia;
+            let e = nalgebra::SymmetricEigen::new(0.5 * (m + m.transpose())).eigenvalues;
+            for x in e.iter() {
+                if *x > 0.0 {
+                    worst = worst.max(x.ln().abs());
+                }
+            }
+        }
+        worst
+    };
+    let mut by_var = [(0usize, 0.0f64); 5];
+    for f in 0..out.n_faces() {
+        let v = variation(f);
+        let b = [0.25f64, 0.5, 1.0, 2.0]
+            .iter()
+            .position(|&x| v <= x)
+            .unwrap_or(4);
+        by_var[b].0 += 1;
+        by_var[b].1 += 1.0 - qs[f].q;
+    }
+    println!(
+        "metric variation across the face in its plane (max |ln λ|): faces, q_avg, deficit share"
+    );
+    for (l, (c, d)) in ["≤0.25", "≤0.5", "≤1", "≤2", ">2"].iter().zip(by_var) {
+        if c > 0 {
+            println!(
+                "  {:5} {:6} {:7.3} {:6.1}%",
+                l,
+                c,
+                1.0 - d / c as f64,
+                100.0 * d / total_def
+            );
+        }
+    }
+    // Deficit by anisotropy: sqrt of the eigenvalue ratio of the first corner's metric
+    // restricted to the face plane (the stretch of the ideal triangle).
+    let mut by_an = [(0usize, 0.0f64); 5];
+    for f in 0..out.n_faces() {
+        let t = out.triangles[f];
+        let [p, q, r] = out.face_points(FaceId::new(f));
+        let e1 = (q - p).normalize();
+        let e2 = (q - p).cross(&(r - p)).cross(&e1).normalize();
+        let m = metrics[t[0].idx()];
+        let m2 = nalgebra::Matrix2::new(
+            e1.dot(&(m * e1)),
+            e1.dot(&(m * e2)),
+            e2.dot(&(m * e1)),
+            e2.dot(&(m * e2)),
+        );
+        let e = nalgebra::SymmetricEigen::new(m2).eigenvalues;
+        let ratio = (e.max() / e.min().max(1e-300)).sqrt();
+        let b = [1.5f64, 3.0, 6.0, 12.0]
+            .iter()
+            .position(|&x| ratio <= x)
+            .unwrap_or(4);
+        by_an[b].0 += 1;
+        by_an[b].1 += 1.0 - qs[f].q;
+    }
+    println!("metric stretch in the face plane: faces, q_avg, deficit share");
+    for (l, (c, d)) in ["≤1.5", "≤3", "≤6", "≤12", ">12"].iter().zip(by_an) {
+        if c > 0 {
+            println!(
+                "  {:5} {:6} {:7.3} {:6.1}%",
+                l,
+                c,
+                1.0 - d / c as f64,
+                100.0 * d / total_def
+            );
+        }
+    }
+    // Per patch: q sum and face count, with its parameterization distortion (PATCH_DUMP).
+    if let Ok(path) = std::env::var("PATCH_DUMP") {
+        let np = res.report.patch_records.len();
+        let mut acc = vec![(0usize, 0.0f64, 0usize); np];
+        for (f, p) in res.face_patch.iter().enumerate() {
+            if let Some(p) = p {
+                acc[p.idx()].0 += 1;
+                acc[p.idx()].1 += qs[f].q;
+                if on_seam[f] {
+                    acc[p.idx()].2 += 1;
+                }
+            }
+        }
+        let mut txt = String::from(
+            "patch faces_in faces_out alive q_avg seam sd maxconf meanconf maxarea retries rounds\n",
+        );
+        for (i, r) in res.report.patch_records.iter().enumerate() {
+            let (c, q, sm) = acc[i];
+            txt += &format!(
+                "{i} {} {} {c} {:.4} {sm} {:.4} {:.4} {:.4} {:.4} {} {}\n",
+                r.faces_in,
+                r.faces_out,
+                if c > 0 { q / c as f64 } else { f64::NAN },
+                r.distortion.symmetric_dirichlet,
+                r.distortion.max_conformal,
+                r.distortion.mean_conformal,
+                r.distortion.max_area_distortion,
+                r.retries,
+                r.fidelity_rounds
+            );
+        }
+        std::fs::write(path, txt).expect("dump");
     }
     // Deficit per patch size bucket (faces produced).
     let mut by_size: HashMap<usize, (usize, f64)> = HashMap::new();
