@@ -146,6 +146,10 @@ pub struct RemeshOptions {
     /// faces (not degenerate, not flipped, locally embedded) and keeps the surface within
     /// the fidelity tolerance. Default `true`.
     pub edge_flips: bool,
+    /// After the flips, move vertices towards their neighbours' centroid on the reference
+    /// surface where the worst face around them improves, then flip again (our addition;
+    /// see [`smooth_pass`]). Default `true`.
+    pub relocate: bool,
 }
 
 impl Default for RemeshOptions {
@@ -162,6 +166,7 @@ impl Default for RemeshOptions {
             sweeps: 1,
             corner_pullback: true,
             edge_flips: true,
+            relocate: true,
         }
     }
 }
@@ -321,6 +326,8 @@ pub struct RemeshReport {
     pub vertices_out: usize,
     /// Edges flipped by the final flip pass ([`RemeshOptions::edge_flips`]).
     pub edge_flips: usize,
+    /// Vertex moves of the final relocation pass ([`RemeshOptions::relocate`]).
+    pub vertex_moves: usize,
 }
 
 /// Progress reported after every patch.
@@ -649,16 +656,23 @@ pub fn remesh(
     }
 
     let mut edge_flips = 0usize;
-    if options.edge_flips {
+    let mut vertex_moves = 0usize;
+    if options.edge_flips || options.relocate {
         let t0 = Instant::now();
         let tol = if eps > 0.0 {
             eps
         } else {
             FidelityOptions::default().max_deviation
         };
-        edge_flips = flip_pass(quality_field, &flip_test, &mut work, embedded_input, tol);
-        // The flips keep every vertex and replace two faces by two faces over the same
-        // quadrilateral; certify the working mesh again anyway.
+        if options.edge_flips {
+            edge_flips = flip_pass(quality_field, &flip_test, &mut work, embedded_input, tol);
+        }
+        if options.relocate {
+            vertex_moves = smooth_pass(quality_field, &flip_test, &mut work, embedded_input, tol);
+            edge_flips += flip_pass(quality_field, &flip_test, &mut work, embedded_input, tol);
+        }
+        // The flips replace two faces by two faces over the same quadrilateral and the moves
+        // keep the connectivity; certify the working mesh again anyway.
         topo = Topology::build(&work.mesh);
         let pid = PatchId::new(n_patch);
         let fail = |e: InvariantError| PipelineError::Certificate {
@@ -723,6 +737,7 @@ pub fn remesh(
         faces_out: work.mesh.n_faces(),
         vertices_out: work.mesh.n_vertices(),
         edge_flips,
+        vertex_moves,
     };
     Ok(RemeshResult {
         mesh: work.mesh,
@@ -1147,6 +1162,130 @@ fn flip_pass(
     total
 }
 
+/// Vertex relocation after the loop (our addition): every vertex off the input boundary is
+/// moved towards the centroid of its neighbours (full, half or quarter step) and projected
+/// onto the reference (its location follows), when the smallest metric quality of its faces
+/// rises, its new faces pass the candidate certificates (not degenerate, not flipped, locally
+/// embedded), and no watched point — its old position and the corners of the reference faces
+/// under it and its neighbours — ends farther from the fan than `tol` unless it already was,
+/// and then not farther than before (tips and creases are not cut off). Three sweeps over the
+/// vertices. The seams between patches are where this matters: their vertices were fixed
+/// patch-boundary vertices. Returns the number of moves.
+fn smooth_pass(
+    field: &MetricField,
+    flip_test: &FlipTest,
+    work: &mut WorkingMesh,
+    embedded_input: bool,
+    tol: f64,
+) -> usize {
+    use crate::quality::{face_metric, triangle_quality};
+    use crate::stitch::PatchVertex;
+    let topo = Topology::build(&work.mesh);
+    let mut metrics: Vec<Matrix3<f64>> = work.locations.iter().map(|l| field.eval_at(l)).collect();
+    let mut moved = 0;
+    for _pass in 0..3 {
+        for vi in 0..work.mesh.n_vertices() {
+            let v = VertexId::new(vi);
+            let fan = topo.vertex_faces(v);
+            if fan.is_empty() || topo.is_boundary_vertex(v) {
+                continue;
+            }
+            let fan_q = |mesh: &TriMesh, metrics: &[Matrix3<f64>]| {
+                fan.iter()
+                    .map(|f| {
+                        let t = mesh.triangles[f.idx()];
+                        triangle_quality(
+                            t.map(|u| mesh.positions[u.idx()]),
+                            &face_metric(metrics, t),
+                        )
+                        .q
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let before = fan_q(&work.mesh, &metrics);
+            let nbrs = topo.vertex_neighbors(v);
+            let old = work.mesh.positions[vi];
+            // Reference vertices under the fan (corners of the reference faces at the fan's
+            // vertices' locations) and their distance to the fan now: no move may push one
+            // of them farther than `tol` away unless it already was (then not farther).
+            let mut watch: Vec<Point3<f64>> = std::iter::once(v)
+                .chain(nbrs.iter().copied())
+                .flat_map(|u| field.reference().face(work.locations[u.idx()].face))
+                .map(|r| field.reference().positions[r.idx()])
+                .collect();
+            watch.push(old);
+            let fan_dist = |mesh: &TriMesh, x: &Point3<f64>| {
+                fan.iter()
+                    .map(|f| {
+                        let t = mesh.triangles[f.idx()].map(|u| mesh.positions[u.idx()]);
+                        point_triangle_distance(x, &t)
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let watch_before: Vec<f64> = watch.iter().map(|x| fan_dist(&work.mesh, x)).collect();
+            let c = nbrs.iter().fold(Vector3::zeros(), |acc, u| {
+                acc + work.mesh.positions[u.idx()].coords
+            }) / nbrs.len() as f64;
+            let mut accepted = false;
+            for step in [1.0, 0.5, 0.25] {
+                let target = Point3::from(old.coords + (c - old.coords) * step);
+                let (loc, p) = field.project(&target);
+                let old_loc = work.locations[vi];
+                let old_m = metrics[vi];
+                work.mesh.positions[vi] = p;
+                work.locations[vi] = loc;
+                metrics[vi] = field.eval_at(&loc);
+                let after = fan_q(&work.mesh, &metrics);
+                let mut ok = after > before;
+                if ok {
+                    let tris: Vec<[Point3<f64>; 3]> = fan
+                        .iter()
+                        .map(|f| work.mesh.triangles[f.idx()].map(|u| work.mesh.positions[u.idx()]))
+                        .collect();
+                    ok = tris
+                        .iter()
+                        .all(|t| !collinear(t) && !flip_test.is_flipped_anywhere(t))
+                        && watch.iter().zip(&watch_before).all(|(x, b)| {
+                            let d = fan_dist(&work.mesh, x);
+                            d <= b.max(tol)
+                        });
+                }
+                if ok && embedded_input {
+                    let r = Replacement {
+                        new_positions: Vec::new(),
+                        new_locations: Vec::new(),
+                        triangles: fan
+                            .iter()
+                            .map(|f| work.mesh.triangles[f.idx()].map(PatchVertex::Existing))
+                            .collect(),
+                    };
+                    ok = certify_candidate_embedded(work, fan, &r).is_ok();
+                }
+                if ok {
+                    accepted = true;
+                    break;
+                }
+                work.mesh.positions[vi] = old;
+                work.locations[vi] = old_loc;
+                metrics[vi] = old_m;
+            }
+            if accepted {
+                moved += 1;
+            }
+        }
+    }
+    moved
+}
+
+/// Euclidean distance from `p` to the triangle `t` (parry's point-triangle projection).
+fn point_triangle_distance(p: &Point3<f64>, t: &[Point3<f64>; 3]) -> f64 {
+    use parry3d_f64::math::Vector as PVec;
+    use parry3d_f64::query::PointQuery;
+    let v = |x: &Point3<f64>| PVec::new(x.x, x.y, x.z);
+    parry3d_f64::shape::Triangle::new(v(&t[0]), v(&t[1]), v(&t[2]))
+        .distance_to_local_point(v(p), false)
+}
+
 /// Distance between the segments `ab` and `cd` (sampled closest-point iteration is not
 /// needed: the exact minimum over the clamped parameters).
 fn segment_distance(a: Point3<f64>, b: Point3<f64>, c: Point3<f64>, d: Point3<f64>) -> f64 {
@@ -1522,6 +1661,62 @@ mod tests {
         assert_eq!(work.mesh.triangles, before);
         // With a tolerance above the ridge height the same flip is made.
         assert_eq!(flip_pass(&field, &flip_test, &mut work, true, 0.1), 1);
+    }
+
+    /// A flat hexagonal fan whose centre sits near one corner: relocation moves it towards
+    /// the middle and the worst triangle improves; on a pyramid whose apex is off-centre the
+    /// apex may move only while the old apex stays within `tol` of the surface.
+    fn hexagon(apex: Point3<f64>) -> TriMesh {
+        let mut positions = vec![apex];
+        let mut triangles = Vec::new();
+        for i in 0..6 {
+            let a = i as f64 * std::f64::consts::PI / 3.0;
+            positions.push(Point3::new(a.cos(), a.sin(), 0.0));
+            triangles.push([VertexId(0), VertexId(1 + i), VertexId(1 + (i + 1) % 6)]);
+        }
+        TriMesh {
+            positions,
+            triangles,
+        }
+    }
+
+    #[test]
+    fn smooth_pass_centres_a_fan_and_keeps_a_tip() {
+        let q_min = |m: &TriMesh| {
+            crate::quality::face_qualities(m, &vec![Matrix3::identity(); m.n_vertices()])
+                .iter()
+                .map(|q| q.q)
+                .fold(f64::INFINITY, f64::min)
+        };
+        for (apex, tol) in [
+            (Point3::new(0.6, 0.1, 0.0), 0.01),
+            (Point3::new(0.3, 0.0, 0.4), 0.01),
+        ] {
+            let reference = hexagon(apex);
+            let field = MetricField::new(reference.clone(), vec![Matrix3::identity(); 7])
+                .expect("identity metric");
+            let flip_test = FlipTest::new(&reference);
+            let mut work = WorkingMesh::from_reference(&reference);
+            let before = q_min(&work.mesh);
+            let moves = smooth_pass(&field, &flip_test, &mut work, true, tol);
+            let p = work.mesh.positions[0];
+            let d = work
+                .mesh
+                .faces()
+                .map(|f| point_triangle_distance(&apex, &work.mesh.face_points(f)))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                d <= tol,
+                "apex {apex}: the old apex is {d} from the surface"
+            );
+            if apex.z == 0.0 {
+                assert!(moves > 0 && p.coords.norm() < 0.3, "centre at {p}");
+                assert!(q_min(&work.mesh) > before + 0.2);
+            } else {
+                // Any move of a sharp apex cuts it: kept.
+                assert_eq!(p, apex);
+            }
+        }
     }
 
     #[test]
