@@ -11,6 +11,7 @@ use conemesh::{EdgeKey, FaceId, TriMesh};
 use nalgebra::Point3;
 use std::collections::HashMap;
 
+#[allow(clippy::needless_range_loop)]
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let input = conemesh::io::read_mesh(std::path::Path::new(&a[1]))
