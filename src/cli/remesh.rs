@@ -60,6 +60,10 @@ pub struct RemeshArgs {
     /// (tips, rims, creases). 0 turns the control off (the paper's metric alone).
     #[arg(long, default_value_t = conemesh::fidelity::FidelityOptions::default().max_deviation)]
     pub hausd: f64,
+    /// Sweeps of Algorithm 1 over the surface: each further sweep remeshes the previous
+    /// sweep's output with new patches, so the old patch seams get remeshed too.
+    #[arg(long, default_value_t = RemeshOptions::default().sweeps)]
+    pub sweeps: usize,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -147,6 +151,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
                 .map(PathBuf::from)
                 .unwrap_or_else(|| PathBuf::from("."))
         })),
+        sweeps: args.sweeps,
         ..RemeshOptions::default()
     };
     let total = field.reference().n_faces() as u64;

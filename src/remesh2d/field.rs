@@ -19,6 +19,9 @@ pub struct PlanarMetricField {
     points: Vec<Point2<f64>>,
     triangles: Vec<[u32; 3]>,
     metrics: Vec<Matrix2<f64>>,
+    /// Optional per-triangle corner tensors (see [`PlanarMetricField::with_corner_metrics`]);
+    /// when present they replace `metrics` in the interpolation.
+    corners: Option<Vec<[Matrix2<f64>; 3]>>,
     lo: Point2<f64>,
     cell: f64,
     nx: usize,
@@ -92,6 +95,7 @@ impl PlanarMetricField {
             points,
             triangles,
             metrics,
+            corners: None,
             lo,
             cell,
             nx,
@@ -116,6 +120,37 @@ impl PlanarMetricField {
         }
         field.buckets = buckets;
         Ok(field)
+    }
+
+    /// Interpolate per-triangle corner tensors instead of the shared vertex tensors: triangle
+    /// `f`'s metric at barycentric `l` is `Σ l_k corners[f][k]`. The field is then piecewise
+    /// linear and discontinuous across the initial edges. Used for the exact pullback
+    /// `J_tᵀ M(v) J_t` of the 3D metric through the parameterization's per-triangle Jacobian
+    /// `J_t` (Eq. 4 without averaging the Jacobians of the triangles around a vertex, which
+    /// is wrong where they differ much: coarse, strongly curved inputs). Tensors are
+    /// clamped with [`clamp_spd`]; errors name the first bad corner.
+    pub fn with_corner_metrics(
+        mut self,
+        corners: Vec<[Matrix2<f64>; 3]>,
+    ) -> Result<Self, Remesh2dError> {
+        if corners.len() != self.triangles.len() {
+            return Err(Remesh2dError::InvalidDomain(format!(
+                "{} triangles but {} corner metric triples",
+                self.triangles.len(),
+                corners.len()
+            )));
+        }
+        let mut clamped = Vec::with_capacity(corners.len());
+        for (t, c) in self.triangles.iter().zip(&corners) {
+            let mut out = [Matrix2::zeros(); 3];
+            for k in 0..3 {
+                let p = self.points[t[k] as usize];
+                out[k] = clamp_spd(&c[k]).ok_or(Remesh2dError::MetricNotSpd { x: p.x, y: p.y })?;
+            }
+            clamped.push(out);
+        }
+        self.corners = Some(clamped);
+        Ok(self)
     }
 
     /// The grid cell of `p`, clamped to the grid (so that bounding-box corners map inside).
@@ -224,6 +259,9 @@ impl PlanarMetricField {
 
     /// The interpolated tensor in triangle `f` at barycentric `l`.
     fn interpolate(&self, f: usize, l: [f64; 3]) -> Matrix2<f64> {
+        if let Some(c) = self.corners.as_ref().and_then(|c| c.get(f)) {
+            return c[0] * l[0] + c[1] * l[1] + c[2] * l[2];
+        }
         let t = self.triangles[f];
         self.metrics[t[0] as usize] * l[0]
             + self.metrics[t[1] as usize] * l[1]
@@ -332,6 +370,30 @@ mod tests {
         // Outside by rounding: the nearest value.
         let m = f.metric(&Point2::new(2.0 + 1e-12, 1.0));
         assert!((m - Matrix2::new(3.0, 0.0, 0.0, 2.0)).norm() < 1e-9);
+        Ok(())
+    }
+
+    /// Corner tensors replace the vertex tensors: the field is linear in each triangle
+    /// between its own corners and jumps across a shared edge.
+    #[test]
+    fn corner_metrics_interpolate_per_triangle() -> Result<(), Remesh2dError> {
+        let points = vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(1.0, 0.0),
+            Point2::new(0.0, 1.0),
+            Point2::new(1.0, 1.0),
+        ];
+        let triangles = vec![[0, 1, 2], [1, 3, 2]];
+        let id = Matrix2::identity();
+        let f = PlanarMetricField::new(points, triangles, vec![id; 4])?;
+        let a = Matrix2::new(4.0, 0.0, 0.0, 1.0);
+        let b = Matrix2::new(1.0, 0.0, 0.0, 9.0);
+        let f = f.with_corner_metrics(vec![[a, a, a], [b, b * 2.0, b]])?;
+        assert!((f.metric(&Point2::new(0.2, 0.2)) - a).norm() < 1e-12);
+        // Centroid of the second triangle: the mean of its corners.
+        let c = f.metric(&Point2::new(2.0 / 3.0, 2.0 / 3.0));
+        assert!((c - b * (4.0 / 3.0)).norm() < 1e-12, "{c}");
+        assert!(f.clone().with_corner_metrics(vec![[a; 3]]).is_err());
         Ok(())
     }
 

@@ -13,7 +13,7 @@ pub use domain::{metric_length, resample_polygon, triangulate_polygon};
 pub use field::PlanarMetricField;
 pub use lct::{remesh_planar, Lct, LctOptions};
 pub use stats::{planar_quality, PlanarQuality};
-pub use transfer::{clamp_spd, transfer_metric, TransferMethod, EIGEN_FLOOR_REL};
+pub use transfer::{clamp_spd, pullback_corners, transfer_metric, TransferMethod, EIGEN_FLOOR_REL};
 
 use nalgebra::{Matrix2, Point2};
 use rand_chacha::ChaCha8Rng;

@@ -93,6 +93,44 @@ pub fn transfer_metric(
         .collect()
 }
 
+/// The exact pullback at every triangle corner: `J_tᵀ M(v) J_t` for each triangle `t` and
+/// corner `v`, with `J_t` the Jacobian of the map from the parameter triangle to the 3D one
+/// (see [`PlanarMetricField::with_corner_metrics`](super::PlanarMetricField::with_corner_metrics)).
+/// Errors as [`transfer_metric`].
+pub fn pullback_corners(
+    disk: &TriMesh,
+    uv: &[Point2<f64>],
+    metrics3d: &[Matrix3<f64>],
+) -> Result<Vec<[Matrix2<f64>; 3]>, Remesh2dError> {
+    let n = disk.n_vertices();
+    if uv.len() != n || metrics3d.len() != n {
+        return Err(Remesh2dError::InvalidDomain(format!(
+            "pullback_corners: {n} vertices but {} uv positions and {} metrics",
+            uv.len(),
+            metrics3d.len()
+        )));
+    }
+    disk.faces()
+        .map(|f| {
+            let [a, b, c] = disk.face(f).map(|v| v.idx());
+            let e3 = nalgebra::Matrix3x2::from_columns(&[
+                disk.positions[b] - disk.positions[a],
+                disk.positions[c] - disk.positions[a],
+            ]);
+            let e2 = Matrix2::from_columns(&[uv[b] - uv[a], uv[c] - uv[a]]);
+            let j = match e2.try_inverse() {
+                Some(inv) if e2.determinant() != 0.0 => e3 * inv,
+                _ => {
+                    return Err(Remesh2dError::InvalidDomain(format!(
+                        "pullback_corners: degenerate parameter triangle {f}"
+                    )))
+                }
+            };
+            Ok([a, b, c].map(|v| j.transpose() * metrics3d[v] * j))
+        })
+        .collect()
+}
+
 /// `Jᵀ M_v J` averaged over the incident triangles, weighted by parameter area.
 fn pullback(
     disk: &TriMesh,
@@ -245,6 +283,61 @@ mod tests {
                 );
             }
         }
+        Ok(())
+    }
+
+    /// A creased patch (two triangles folded 90° along their shared edge, laid flat in the
+    /// plane): the corner pullback of the identity metric measures every parameter edge of
+    /// its triangle at its exact 3D length, also at the corners on the crease, while the
+    /// vertex average of the two Jacobians does not (the upright triangle's parameter edges
+    /// are stretched 2× in the plane).
+    #[test]
+    fn corner_pullback_is_exact_across_a_crease() -> Result<(), Remesh2dError> {
+        use crate::ids::VertexId;
+        use nalgebra::Point3;
+        // Crease along x from (0,0,0) to (1,0,0); one triangle flat (y < 0), one upright (z > 0).
+        let disk = TriMesh {
+            positions: vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(0.5, 0.0, 1.0),
+                Point3::new(0.5, -1.0, 0.0),
+            ],
+            triangles: vec![
+                [VertexId(0), VertexId(1), VertexId(2)],
+                [VertexId(1), VertexId(0), VertexId(3)],
+            ],
+        };
+        // A non-isometric but bijective layout: the upright triangle is squashed to half
+        // height in the plane.
+        let uv = vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(1.0, 0.0),
+            Point2::new(0.5, 0.5),
+            Point2::new(0.5, -1.0),
+        ];
+        let metrics = vec![Matrix3::identity(); 4];
+        let corners = pullback_corners(&disk, &uv, &metrics)?;
+        let averaged = transfer_metric(&disk, &uv, &metrics, TransferMethod::JacobianPullback)?;
+        let mut averaged_error: f64 = 0.0;
+        for (t, tri) in disk.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k].idx(), tri[(k + 1) % 3].idx());
+                let e2 = uv[b] - uv[a];
+                let l3 = (disk.positions[b] - disk.positions[a]).norm();
+                for c in 0..3 {
+                    let l = e2.dot(&(corners[t][c] * e2)).sqrt();
+                    assert!((l - l3).abs() < 1e-12, "t{t} corner {c}: {l} vs {l3}");
+                    let v = tri[c].idx();
+                    let la = e2.dot(&(averaged[v] * e2)).sqrt();
+                    averaged_error = averaged_error.max((la / l3 - 1.0).abs());
+                }
+            }
+        }
+        assert!(
+            averaged_error > 0.2,
+            "the averaged transfer was exact too: {averaged_error}"
+        );
         Ok(())
     }
 
