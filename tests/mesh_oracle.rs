@@ -439,3 +439,177 @@ fn certificates_agree_with_the_oracle_on_soups() {
         assert_eq!(certify_same_topology(&m, &m), Ok(()));
     }
 }
+
+/// Exact zero-area test on small integer coordinates: the cross product is exact in i64.
+fn zero_area(m: &TriMesh, f: FaceId) -> bool {
+    let p = m.face_points(f).map(|p| p.coords.map(|x| x as i64));
+    let (u, v) = (p[1] - p[0], p[2] - p[0]);
+    u.cross(&v) == nalgebra::Vector3::zeros()
+}
+
+/// Soups over a 3×3×3 integer grid (many collinear corners, touching and coplanar faces):
+/// the degenerate faces are exactly the integer zero-area ones; `self_intersections` reports
+/// each of them as `(f, f)` only, and otherwise every pair `f < g` of non-degenerate faces
+/// for which `faces_intersect` holds (all-pairs, no broad phase).
+#[test]
+fn self_intersections_with_degenerate_faces_equal_all_pairs() {
+    use conemesh::invariants::{
+        certify_no_degenerate_faces, certify_no_self_intersections, degenerate_faces,
+        faces_intersect, is_degenerate, self_intersections,
+    };
+    let mut rng = Rng::seed_from_u64(0xdead);
+    let mut degenerate_seen = 0;
+    for case in 0..60 {
+        let nv = rng.random_range(4..10);
+        let nf = rng.random_range(2..16);
+        let positions: Vec<Point3<f64>> = (0..nv)
+            .map(|_| {
+                Point3::new(
+                    rng.random_range(0..3) as f64,
+                    rng.random_range(0..3) as f64,
+                    rng.random_range(0..3) as f64,
+                )
+            })
+            .collect();
+        let mut m = soup(&mut rng, nv, nf);
+        m.positions = positions;
+        let deg: Vec<FaceId> = m.faces().filter(|&f| zero_area(&m, f)).collect();
+        degenerate_seen += deg.len();
+        for f in m.faces() {
+            assert_eq!(is_degenerate(&m, f), deg.contains(&f), "case {case} {f:?}");
+        }
+        assert_eq!(degenerate_faces(&m), deg, "case {case}");
+        assert_eq!(certify_no_degenerate_faces(&m).is_ok(), deg.is_empty());
+        let mut expect = Vec::new();
+        for f in m.faces() {
+            if deg.contains(&f) {
+                expect.push((f, f));
+                continue;
+            }
+            for g in m.faces().filter(|&g| g > f && !deg.contains(&g)) {
+                if faces_intersect(&m, f, g) {
+                    expect.push((f, g));
+                }
+            }
+        }
+        expect.sort_unstable();
+        let got = self_intersections(&m);
+        assert_eq!(
+            got, expect,
+            "case {case}: {:?} {:?}",
+            m.positions, m.triangles
+        );
+        assert_eq!(certify_no_self_intersections(&m).is_ok(), expect.is_empty());
+    }
+    assert!(degenerate_seen > 20, "{degenerate_seen}");
+}
+
+/// `faces_intersect` is symmetric and invariant under rotating the corners of either face
+/// (the shared-vertex bookkeeping must not depend on where the shared corners sit).
+#[test]
+fn faces_intersect_ignores_corner_rotation_and_order() {
+    use conemesh::invariants::{faces_intersect, is_degenerate};
+    let mut rng = Rng::seed_from_u64(0xfa11);
+    let mut hits = [0usize; 4];
+    for _ in 0..40 {
+        let nv = rng.random_range(4..8);
+        let mut m = soup(&mut rng, nv, 12);
+        for p in &mut m.positions {
+            *p = Point3::new(
+                rng.random_range(0..3) as f64,
+                rng.random_range(0..3) as f64,
+                rng.random_range(0..2) as f64,
+            );
+        }
+        for f in m.faces() {
+            for g in m.faces().filter(|&g| g != f) {
+                if is_degenerate(&m, f) || is_degenerate(&m, g) {
+                    continue;
+                }
+                let r = faces_intersect(&m, f, g);
+                assert_eq!(faces_intersect(&m, g, f), r);
+                let shared = m.face(f).iter().filter(|v| m.face(g).contains(v)).count();
+                hits[shared] += usize::from(r);
+                for k in 1..3 {
+                    let mut rot = m.clone();
+                    rot.triangles[f.idx()].rotate_left(k);
+                    assert_eq!(faces_intersect(&rot, f, g), r, "rotate f by {k}");
+                    let mut rot = m.clone();
+                    rot.triangles[g.idx()].rotate_left(k);
+                    assert_eq!(faces_intersect(&rot, f, g), r, "rotate g by {k}");
+                }
+            }
+        }
+    }
+    // Every sharing case occurs with an intersection.
+    assert!(hits.iter().all(|&h| h > 0), "{hits:?}");
+}
+
+/// The topology certificate names the first quantity that differs, in the order
+/// components, boundary loops, per-component (genus, loops); renumbered components compare
+/// equal.
+#[test]
+fn same_topology_names_the_first_difference() {
+    let shift = |m: &TriMesh, dx: f64| {
+        let mut m = m.clone();
+        for p in &mut m.positions {
+            p.x += dx;
+        }
+        m
+    };
+    let union = |a: &TriMesh, b: &TriMesh| {
+        let mut m = a.clone();
+        let n = m.positions.len() as u32;
+        m.positions.extend(b.positions.iter().copied());
+        m.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|v| VertexId(v.0 + n))));
+        m
+    };
+    let what = |a: &TriMesh, b: &TriMesh| match certify_same_topology(a, b) {
+        Ok(()) => "same".to_string(),
+        Err(InvariantError::TopologyChanged { what, .. }) => what,
+        Err(e) => panic!("{e}"),
+    };
+    let sphere = generators::icosphere(1.0, 1);
+    let torus = generators::torus(1.0, 0.3, 12, 6);
+    let disk = generators::disk(1.0, 2, 8);
+    let sphere_torus = union(&sphere, &shift(&torus, 4.0));
+    let torus_sphere = union(&torus, &shift(&sphere, 4.0));
+    assert_eq!(what(&sphere_torus, &torus_sphere), "same");
+    assert_eq!(what(&sphere, &sphere_torus), "components");
+    assert_eq!(what(&sphere_torus, &sphere), "components");
+    // Same component count, different loop count.
+    assert_eq!(what(&sphere, &disk), "boundary loops");
+    assert_eq!(what(&disk, &sphere), "boundary loops");
+    // Same counts, different genus.
+    assert_eq!(
+        what(&sphere, &torus),
+        "per-component genus and boundary loops"
+    );
+    // Same totals (2 components, 1 loop), loops on different components:
+    // {disk, torus} vs {sphere, disk}: (genus, loops) pair up differently.
+    let a = union(&disk, &shift(&torus, 4.0));
+    let b = union(&sphere, &shift(&disk, 4.0));
+    assert_eq!(what(&a, &b), "per-component genus and boundary loops");
+}
+
+/// Boundary positions are compared as points: −0.0 and +0.0 are the same coordinate.
+#[test]
+fn boundary_preserved_identifies_signed_zeros() {
+    use conemesh::invariants::certify_boundary_preserved;
+    let disk = generators::disk(1.0, 2, 8);
+    let t = Topology::build(&disk);
+    let mut before = disk.clone();
+    let mut after = disk.clone();
+    // Put a boundary vertex on the plane x = 0, as +0.0 before and −0.0 after.
+    let b = t.boundary_loops()[0][0];
+    before.positions[b.idx()].x = 0.0;
+    after.positions[b.idx()].x = -0.0;
+    before.positions[b.idx()].z = -0.0;
+    after.positions[b.idx()].z = 0.0;
+    assert_eq!(certify_boundary_preserved(&before, &after), Ok(()));
+    assert_eq!(certify_boundary_preserved(&after, &before), Ok(()));
+    // A real move is still caught.
+    after.positions[b.idx()].x = f64::MIN_POSITIVE;
+    assert!(certify_boundary_preserved(&before, &after).is_err());
+}
