@@ -624,3 +624,22 @@ fn empty_mesh_measures_are_zero() {
     let e = conemesh::quality::unique_edges(&seg)[0];
     assert_eq!(edge_metric_length(&seg, &neg, e), 0.0);
 }
+
+/// The thresholds are strict (Sec. 4.1 / Table 1: "θ < 10°", "> 120°"): a triangle whose
+/// smallest angle is exactly 10°, 20° or 30°, or whose largest is exactly 120°, is not
+/// counted in that class.
+#[test]
+fn angle_percentages_use_strict_thresholds() {
+    use conemesh::quality::stats_of;
+    use conemesh::quality::TriangleQuality;
+    let t = |a: f64, b: f64| TriangleQuality {
+        q: 0.5,
+        angles: [a, b, 180.0 - a - b],
+    };
+    // (min, max): (10, 85), (20, 80), (30, 120).
+    let s = stats_of(&[t(10.0, 85.0), t(20.0, 80.0), t(30.0, 30.0)]);
+    assert_eq!(s.pct_min_angle_lt_10, 0.0);
+    assert_eq!(s.pct_min_angle_lt_20, 100.0 / 3.0);
+    assert_eq!(s.pct_min_angle_lt_30, 200.0 / 3.0);
+    assert_eq!(s.pct_max_angle_gt_120, 0.0);
+}
