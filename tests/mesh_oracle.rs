@@ -593,6 +593,71 @@ fn same_topology_names_the_first_difference() {
     assert_eq!(what(&a, &b), "per-component genus and boundary loops");
 }
 
+/// The certificate's error shows both sides: counts, or the sorted per-component
+/// `(genus, loops)` lists, with `?` for a genus that is not a non-negative integer.
+#[test]
+fn same_topology_error_shows_both_sides() {
+    let sides = |a: &TriMesh, b: &TriMesh| match certify_same_topology(a, b) {
+        Err(InvariantError::TopologyChanged { before, after, .. }) => (before, after),
+        other => panic!("{other:?}"),
+    };
+    let sphere = generators::icosphere(1.0, 1);
+    let torus = generators::torus(1.0, 0.3, 12, 6);
+    assert_eq!(
+        sides(&sphere, &torus),
+        (
+            "[(genus 0, 0 loops)]".to_string(),
+            "[(genus 1, 0 loops)]".to_string()
+        )
+    );
+    let disk = generators::disk(1.0, 2, 8);
+    assert_eq!(sides(&sphere, &disk), ("0".to_string(), "1".to_string()));
+    // A Möbius band: χ = 0 and one boundary curve, so 2 − χ − b is odd and its genus is not
+    // an integer (`?`). Against a sphere with as many holes (one component, the same loop
+    // count) the error prints both per-component signatures.
+    let n = 6;
+    let mut p = Vec::new();
+    for i in 0..n {
+        let a = i as f64 * std::f64::consts::TAU / n as f64;
+        p.push(Point3::new(2.0 * a.cos(), 2.0 * a.sin(), 0.5));
+        p.push(Point3::new(2.0 * a.cos(), 2.0 * a.sin(), -0.5));
+    }
+    let mut f = Vec::new();
+    for i in 0..n {
+        let (t0, b0) = (2 * i, 2 * i + 1);
+        let (t1, b1) = if i + 1 < n {
+            (2 * i + 2, 2 * i + 3)
+        } else {
+            (1, 0)
+        };
+        f.push([t0, b0, b1]);
+        f.push([t0, b1, t1]);
+    }
+    let band = TriMesh::from_indices(p, &f).expect("band");
+    let c = Topology::build(&band).components()[0].clone();
+    let b = c.boundary_loops;
+    let mut holes = generators::icosphere(1.0, 1);
+    let mut removed: Vec<[VertexId; 3]> = Vec::new();
+    holes.triangles.retain(|t| {
+        let far = removed.iter().all(|r| !r.iter().any(|v| t.contains(v)));
+        if removed.len() < b && far {
+            removed.push(*t);
+            false
+        } else {
+            true
+        }
+    });
+    let g = c.genus.map_or("?".to_string(), |g| g.to_string());
+    assert_eq!(
+        sides(&band, &holes),
+        (
+            format!("[(genus {g}, {b} loops)]"),
+            format!("[(genus 0, {b} loops)]")
+        )
+    );
+    assert!(c.genus.is_none(), "{c:?}");
+}
+
 /// Boundary positions are compared as points: −0.0 and +0.0 are the same coordinate.
 #[test]
 fn boundary_preserved_identifies_signed_zeros() {
