@@ -412,6 +412,58 @@ fn genus_of_closed_surfaces_and_impossible_counts() {
     assert_eq!(c.genus, expect);
 }
 
+/// χ = 2 − 2g − b has no non-negative integer solution g for a closed non-orientable
+/// surface (the 6-vertex projective plane: χ = 1, b = 0, so 2g = 1) nor for three closed
+/// tetrahedra hinged on one edge (χ = 8 − 16 + 12 = 4, b = 0, so 2g = −2): the genus is
+/// `None`, not a rounded or wrapped number.
+#[test]
+fn genus_is_none_when_two_minus_chi_minus_b_is_odd_or_negative() {
+    let pts = |n: usize| -> Vec<Point3<f64>> {
+        (0..n)
+            .map(|i| {
+                let a = i as f64;
+                Point3::new(a.cos(), a.sin(), 0.1 * a)
+            })
+            .collect()
+    };
+    let rp2 = TriMesh::from_indices(
+        pts(6),
+        &[
+            [0, 1, 2],
+            [0, 2, 3],
+            [0, 3, 4],
+            [0, 4, 5],
+            [0, 5, 1],
+            [1, 2, 4],
+            [2, 3, 5],
+            [3, 4, 1],
+            [4, 5, 2],
+            [5, 1, 3],
+        ],
+    )
+    .expect("RP2");
+    let t = check_against_oracle(&rp2, "projective plane");
+    assert!(t.edge_face_counts().iter().all(|&c| c == 2));
+    assert!(t.boundary_loops().is_empty());
+    assert!(!t.inconsistent_edges().is_empty(), "non-orientable");
+    assert_eq!(t.components().len(), 1);
+    assert_eq!(t.components()[0].euler, 1);
+    assert_eq!(t.components()[0].genus, None);
+
+    // Tetrahedra (0, 1, a, b) for (a, b) = (2, 3), (4, 5), (6, 7), all on the edge (0, 1).
+    let mut faces = Vec::new();
+    for (a, b) in [(2, 3), (4, 5), (6, 7)] {
+        faces.extend([[0, 1, a], [1, 0, b], [0, a, b], [1, b, a]]);
+    }
+    let hinge = TriMesh::from_indices(pts(8), &faces).expect("hinge");
+    let t = check_against_oracle(&hinge, "three tetrahedra on an edge");
+    assert_eq!(t.non_manifold_edges().len(), 1);
+    assert!(t.boundary_loops().is_empty());
+    assert_eq!(t.components().len(), 1);
+    assert_eq!(t.components()[0].euler, 4);
+    assert_eq!(t.components()[0].genus, None);
+}
+
 /// The certificates report exactly what the oracle finds, on the random soups.
 #[test]
 fn certificates_agree_with_the_oracle_on_soups() {
