@@ -718,10 +718,13 @@ fn boundary_preserved_identifies_signed_zeros() {
     let t = Topology::build(&disk);
     let mut before = disk.clone();
     let mut after = disk.clone();
-    // Put a boundary vertex on the plane x = 0, as +0.0 before and −0.0 after.
+    // Move a boundary vertex to the origin, written with a different sign of zero on every
+    // axis before and after.
     let b = t.boundary_loops()[0][0];
     before.positions[b.idx()].x = 0.0;
     after.positions[b.idx()].x = -0.0;
+    before.positions[b.idx()].y = -0.0;
+    after.positions[b.idx()].y = 0.0;
     before.positions[b.idx()].z = -0.0;
     after.positions[b.idx()].z = 0.0;
     assert_eq!(certify_boundary_preserved(&before, &after), Ok(()));
