@@ -643,3 +643,44 @@ fn angle_percentages_use_strict_thresholds() {
     assert_eq!(s.pct_min_angle_lt_30, 200.0 / 3.0);
     assert_eq!(s.pct_max_angle_gt_120, 0.0);
 }
+
+/// Zero computed area means degenerate, reported exactly as q = 0 and angles {0°, 0°, 180°}
+/// with the 180° at the middle point, even when rounding leaves the *other* pairs of
+/// edges a few ulps from parallel (so angles measured from them would be 1e-14° instead
+/// of 0°). Points p2 = k·p1 on a line through the origin, searched over small integers and
+/// rational k until e0 × e1 rounds to exactly zero.
+#[test]
+fn zero_area_triangles_get_exact_degenerate_angles() {
+    let id = Matrix3::identity();
+    let mut rng = Rng::seed_from_u64(0x2e40);
+    let (mut zero_area, mut other_pairs_not_parallel) = (0, 0);
+    for _ in 0..2000 {
+        let p1 = Vector3::new(
+            rng.random_range(1..10) as f64,
+            rng.random_range(1..10) as f64,
+            rng.random_range(0..3) as f64,
+        );
+        let k = rng.random_range(2..50) as f64 / [3.0, 7.0, 10.0][rng.random_range(0..3)];
+        if k == 1.0 {
+            continue; // a repeated point, not a line
+        }
+        let p = [Point3::origin(), Point3::from(p1), Point3::from(p1 * k)];
+        let e = [p[1] - p[0], p[2] - p[1], p[0] - p[2]];
+        if e[0].cross(&e[1]) != Vector3::zeros() {
+            continue;
+        }
+        zero_area += 1;
+        if e[1].cross(&e[2]) != Vector3::zeros() || e[2].cross(&e[0]) != Vector3::zeros() {
+            other_pairs_not_parallel += 1;
+        }
+        let t = triangle_quality(p, &id);
+        // The middle point: p1 when k > 1, p2 when k < 1.
+        let mut expect = [0.0; 3];
+        expect[if k > 1.0 { 1 } else { 2 }] = 180.0;
+        assert_eq!((t.q, t.angles), (0.0, expect), "p1 {p1:?} k {k}");
+    }
+    assert!(
+        zero_area > 100 && other_pairs_not_parallel > 20,
+        "{zero_area} {other_pairs_not_parallel}"
+    );
+}
