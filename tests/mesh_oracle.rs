@@ -209,6 +209,7 @@ fn check_against_oracle(m: &TriMesh, what: &str) -> Topology {
         label[s] = n_comp;
         let mut stack = vec![s];
         while let Some(f) = stack.pop() {
+            #[allow(clippy::needless_range_loop)]
             for g in 0..nf {
                 let shares_edge = m.triangles[f]
                     .iter()

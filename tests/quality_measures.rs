@@ -469,12 +469,12 @@ fn quality_stats_and_conformity_match_brute_force() {
                 oracle_quality(metric_sides(&m.face_points(f), &mt))
             })
             .collect();
-        let fq = face_qualities(&m, &given);
+        let fq = face_qualities(&m, given);
         assert_eq!(fq.len(), m.n_faces());
         for (t, (q, a)) in fq.iter().zip(&per_face) {
             assert!((t.q - q).abs() < 1e-9 && (t.angles[0] - a[0]).abs() < 1e-6);
         }
-        let s = quality_stats(&m, &given);
+        let s = quality_stats(&m, given);
         let nf = per_face.len() as f64;
         let mins: Vec<f64> = per_face
             .iter()
@@ -559,11 +559,11 @@ fn quality_stats_and_conformity_match_brute_force() {
             })
             .collect();
         for (e, l) in edges.iter().zip(&lens) {
-            assert!((edge_metric_length(&m, &given, *e) - l).abs() < 1e-9 * l.max(1.0));
+            assert!((edge_metric_length(&m, given, *e) - l).abs() < 1e-9 * l.max(1.0));
         }
         let ne = lens.len() as f64;
         let avg = lens.iter().sum::<f64>() / ne;
-        assert!((edge_length_average(&m, &given) - avg).abs() < 1e-9 * avg);
+        assert!((edge_length_average(&m, given) - avg).abs() < 1e-9 * avg);
         // Conformity against a target in the middle of the lengths, so that some edges fall
         // outside [1/√2, √2] on each side.
         let l_tar = avg;
@@ -579,7 +579,7 @@ fn quality_stats_and_conformity_match_brute_force() {
             (sorted[k / 2 - 1] + sorted[k / 2]) / 2.0
         };
         let inside = count(&r, &|x| x >= 0.5f64.sqrt() && x <= 2f64.sqrt());
-        let c = edge_conformity(&m, &given, l_tar);
+        let c = edge_conformity(&m, given, l_tar);
         assert_eq!(c.edges, k);
         assert!((c.mean - mean).abs() < 1e-9, "{c:?}");
         assert!((c.std - std).abs() < 1e-9, "{c:?} vs {std}");
