@@ -42,7 +42,7 @@ proptest! {
         let m = surface(kind, seed);
         let topo = Topology::build(&m);
         let processed = vec![false; m.n_faces()];
-        let ctx = PatchContext { mesh: &m, topology: &topo, processed: &processed, feature_edges: None };
+        let ctx = PatchContext { mesh: &m, topology: &topo, processed: &processed, feature_edges: None, corners: None };
         let mut rng = conemesh::Rng::seed_from_u64(seed);
         let start = FaceId::new(rng.random_range(0..m.n_faces()));
         let mut disk = DiskPatch::new(&ctx, start);

@@ -89,6 +89,23 @@ pub enum PipelineError {
         /// faces left
         unprocessed: usize,
     },
+    /// The strategy returned a patch with a corner vertex in its interior (the contract of
+    /// [`PatchStrategy`] with [`crate::patches::PatchContext::corners`]).
+    #[error(
+        "patch {patch} (seed {seed}) contains the corner vertex {vertex} in its interior; the strategy must keep corners on patch boundaries"
+    )]
+    CornerInterior {
+        /// which patch
+        patch: PatchId,
+        /// its seed
+        seed: VertexId,
+        /// the corner vertex
+        vertex: VertexId,
+    },
+    /// A corner vertex of the input ([`RemeshOptions::corner_defect`]) is not in the output
+    /// at its input position.
+    #[error("final mesh: the input's corner vertex {0} was removed or moved")]
+    CornerLost(VertexId),
     /// The patch budget ran out.
     #[error("stopped after {0} patches (--max-patches) with {1} faces unprocessed")]
     Budget(usize, usize),
@@ -151,6 +168,11 @@ pub struct RemeshOptions {
     /// surface where the worst face around them improves, then flip again (our addition;
     /// see [`smooth_pass`]). Default `true`.
     pub relocate: bool,
+    /// Input vertices whose angle defect `|2π − Σθ|` is at least this many radians are kept
+    /// as vertices of the output (our addition, see [`crate::patches::corner_vertices`]): no
+    /// patch contains them in its interior and the relocation pass does not move them.
+    /// `None` keeps no vertex (the paper). Default `Some(1.0)`.
+    pub corner_defect: Option<f64>,
 }
 
 impl Default for RemeshOptions {
@@ -168,6 +190,7 @@ impl Default for RemeshOptions {
             corner_pullback: false,
             edge_flips: true,
             relocate: true,
+            corner_defect: Some(1.0),
         }
     }
 }
@@ -329,6 +352,9 @@ pub struct RemeshReport {
     pub edge_flips: usize,
     /// Vertex moves of the final relocation pass ([`RemeshOptions::relocate`]).
     pub vertex_moves: usize,
+    /// Input vertices kept as corners ([`RemeshOptions::corner_defect`]); each is certified
+    /// to be a vertex of the output at its input position.
+    pub corners: usize,
 }
 
 /// Progress reported after every patch.
@@ -363,7 +389,7 @@ pub fn remesh(
     field: &MetricField,
     stages: &Stages,
     options: &RemeshOptions,
-    mut on_progress: impl FnMut(Progress),
+    on_progress: impl FnMut(Progress),
 ) -> Result<RemeshResult, PipelineError> {
     let reference = field.reference();
     if reference.n_faces() == 0 {
@@ -389,28 +415,51 @@ pub fn remesh(
     // metric is scaled up isotropically where a triangle of the target size would cut off
     // more of the reference than the tolerance allows. L_tar above is from the unscaled
     // metric, as is every quality measure.
-    let scaled_field;
-    let mut fid_scale: Vec<f64> = Vec::new();
     let min_edge = options.fidelity.min_edge_ratio * mean_edge_length(reference);
-    // The metric every quality measure uses (the unscaled one).
-    let quality_field = field;
-    let field = if options.fidelity.max_deviation > 0.0 {
+    let fid_scale: Vec<f64> = if eps > 0.0 {
         let topo = Topology::build(reference);
-        let s = fidelity::a_priori_scale(
+        fidelity::a_priori_scale(
             reference,
             &topo,
             field.vertex_metrics(),
             l_tar,
-            options.fidelity.max_deviation,
+            eps,
             min_edge,
-        );
+        )
+    } else {
+        Vec::new()
+    };
+    remesh_core(
+        field,
+        stages,
+        options,
+        (l_avg, l_tar, min_edge),
+        fid_scale,
+        on_progress,
+    )
+}
+
+/// Algorithm 1 proper on `field`'s reference, with the fidelity scale precomputed.
+fn remesh_core(
+    field: &MetricField,
+    stages: &Stages,
+    options: &RemeshOptions,
+    (l_avg, l_tar, min_edge): (f64, f64, f64),
+    fid_scale: Vec<f64>,
+    mut on_progress: impl FnMut(Progress),
+) -> Result<RemeshResult, PipelineError> {
+    let reference = field.reference();
+    let eps = options.fidelity.max_deviation;
+    let scaled_field;
+    // The metric every quality measure uses (the unscaled one).
+    let quality_field = field;
+    let field = if !fid_scale.is_empty() {
         let metrics = field
             .vertex_metrics()
             .iter()
-            .zip(&s)
+            .zip(&fid_scale)
             .map(|(m, f)| m * *f)
             .collect();
-        fid_scale = s;
         scaled_field = MetricField::new(reference.clone(), metrics)
             .map_err(|e| PipelineError::Input(format!("fidelity-scaled metric: {e}")))?;
         &scaled_field
@@ -441,6 +490,18 @@ pub fn remesh(
             PipelineError::Input(format!("the input mesh is not an oriented manifold: {e}"))
         })?;
     let signature = topology_signature(&ref_topo);
+    // Cone points of the input stay vertices of the output (working-mesh vertex ids of the
+    // input are stable during the loop; new vertices are never corners).
+    let corners: Vec<bool> = match options.corner_defect {
+        Some(d) if d.is_nan() || d <= 0.0 => {
+            return Err(PipelineError::Input(format!(
+                "corner angle defect must be a positive number of radians, got {d}"
+            )))
+        }
+        Some(d) => crate::patches::corner_vertices(reference, &ref_topo, d),
+        None => Vec::new(),
+    };
+    let n_corners = corners.iter().filter(|c| **c).count();
     // The input's boundary edges, by vertex ids (input vertices are never renumbered during
     // the loop and boundary vertices are never moved: the remesher keeps patch boundaries).
     let input_boundary: Vec<EdgeKey> = ref_topo
@@ -483,6 +544,7 @@ pub fn remesh(
             topology: &topo,
             processed: &work.processed,
             feature_edges: None,
+            corners: Some(&corners),
         };
         let patch = match stages.patches.next_patch(&ctx, &mut rng) {
             Ok(Some(p)) => p,
@@ -527,6 +589,13 @@ pub fn remesh(
                 }
             })?;
             cert.disk += 1;
+            if let Some(vertex) = interior_corner(&work.mesh, &topo, &faces, &corners) {
+                return Err(PipelineError::CornerInterior {
+                    patch: pid,
+                    seed,
+                    vertex,
+                });
+            }
             times.patches += t0.elapsed().as_secs_f64();
             let attempt = remesh_patch(
                 field,
@@ -613,7 +682,14 @@ pub fn remesh(
                         );
                     }
                     fallback.shrinks += 1;
-                    faces = shrink_patch(&work, &topo, &faces, patch.seed_face, faces.len() / 2);
+                    faces = shrink_patch(
+                        &work,
+                        &topo,
+                        &faces,
+                        patch.seed_face,
+                        faces.len() / 2,
+                        &corners,
+                    );
                 }
             }
         };
@@ -672,7 +748,14 @@ pub fn remesh(
             edge_flips = flip_pass(quality_field, &flip_test, &mut work, embedded_input, tol);
         }
         if options.relocate {
-            vertex_moves = smooth_pass(quality_field, &flip_test, &mut work, embedded_input, tol);
+            vertex_moves = smooth_pass(
+                quality_field,
+                &flip_test,
+                &mut work,
+                embedded_input,
+                tol,
+                &corners,
+            );
             edge_flips += flip_pass(quality_field, &flip_test, &mut work, embedded_input, tol);
         }
         // The flips replace two faces by two faces over the same quadrilateral and the moves
@@ -698,6 +781,23 @@ pub fn remesh(
         certify_input_boundary(&work.mesh, &topo, reference, &input_boundary).map_err(fail)?;
         times.certify += t0.elapsed().as_secs_f64();
     }
+    // Every corner is still a vertex of the working mesh, where the input had it.
+    let t0 = Instant::now();
+    let used = {
+        let mut u = vec![false; work.mesh.n_vertices()];
+        work.mesh
+            .triangles
+            .iter()
+            .flatten()
+            .for_each(|v| u[v.idx()] = true);
+        u
+    };
+    if let Some(v) = (0..corners.len())
+        .find(|&v| corners[v] && (!used[v] || work.mesh.positions[v] != reference.positions[v]))
+    {
+        return Err(PipelineError::CornerLost(VertexId::new(v)));
+    }
+    times.certify += t0.elapsed().as_secs_f64();
     work.compact();
     let t0 = Instant::now();
     if options.check_self_intersections {
@@ -742,6 +842,7 @@ pub fn remesh(
         vertices_out: work.mesh.n_vertices(),
         edge_flips,
         vertex_moves,
+        corners: n_corners,
     };
     Ok(RemeshResult {
         mesh: work.mesh,
@@ -1197,6 +1298,7 @@ fn smooth_pass(
     work: &mut WorkingMesh,
     embedded_input: bool,
     tol: f64,
+    corners: &[bool],
 ) -> usize {
     use crate::quality::{face_metric, triangle_quality};
     use crate::stitch::PatchVertex;
@@ -1207,7 +1309,10 @@ fn smooth_pass(
         for vi in 0..work.mesh.n_vertices() {
             let v = VertexId::new(vi);
             let fan = topo.vertex_faces(v);
-            if fan.is_empty() || topo.is_boundary_vertex(v) {
+            if fan.is_empty()
+                || topo.is_boundary_vertex(v)
+                || corners.get(vi).copied().unwrap_or(false)
+            {
                 continue;
             }
             let fan_q = |mesh: &TriMesh, metrics: &[Matrix3<f64>]| {
@@ -1247,29 +1352,46 @@ fn smooth_pass(
                 acc + work.mesh.positions[u.idx()].coords
             }) / nbrs.len() as f64;
             let mut accepted = false;
+            // Targets: the metric-optimal point (full and half step), then the centroid
+            // (full, half, quarter step); tried best first by the fan's smallest quality.
+            let mut targets: Vec<Point3<f64>> = Vec::with_capacity(5);
+            if let Some(opt) = metric_optimal_point(&work.mesh, fan, v, &metrics[vi]) {
+                targets.push(opt);
+                targets.push(Point3::from((old.coords + opt.coords) * 0.5));
+            }
             for step in [1.0, 0.5, 0.25] {
-                let target = Point3::from(old.coords + (c - old.coords) * step);
-                let (loc, p) = field.project(&target);
-                let old_loc = work.locations[vi];
-                let old_m = metrics[vi];
+                targets.push(Point3::from(old.coords + (c - old.coords) * step));
+            }
+            let old_loc = work.locations[vi];
+            let old_m = metrics[vi];
+            let mut scored: Vec<(f64, SurfaceLocation, Point3<f64>)> = targets
+                .iter()
+                .map(|target| {
+                    let (loc, p) = field.project(target);
+                    work.mesh.positions[vi] = p;
+                    metrics[vi] = field.eval_at(&loc);
+                    (fan_q(&work.mesh, &metrics), loc, p)
+                })
+                .filter(|(q, _, _)| *q > before)
+                .collect();
+            work.mesh.positions[vi] = old;
+            metrics[vi] = old_m;
+            scored.sort_by(|a, b| b.0.total_cmp(&a.0));
+            for (_, loc, p) in scored {
                 work.mesh.positions[vi] = p;
                 work.locations[vi] = loc;
                 metrics[vi] = field.eval_at(&loc);
-                let after = fan_q(&work.mesh, &metrics);
-                let mut ok = after > before;
-                if ok {
-                    let tris: Vec<[Point3<f64>; 3]> = fan
-                        .iter()
-                        .map(|f| work.mesh.triangles[f.idx()].map(|u| work.mesh.positions[u.idx()]))
-                        .collect();
-                    ok = tris
-                        .iter()
-                        .all(|t| !collinear(t) && !flip_test.is_flipped_anywhere(t))
-                        && watch.iter().zip(&watch_before).all(|(x, b)| {
-                            let d = fan_dist(&work.mesh, x);
-                            d <= b.max(tol)
-                        });
-                }
+                let tris: Vec<[Point3<f64>; 3]> = fan
+                    .iter()
+                    .map(|f| work.mesh.triangles[f.idx()].map(|u| work.mesh.positions[u.idx()]))
+                    .collect();
+                let mut ok = tris
+                    .iter()
+                    .all(|t| !collinear(t) && !flip_test.is_flipped_anywhere(t))
+                    && watch.iter().zip(&watch_before).all(|(x, b)| {
+                        let d = fan_dist(&work.mesh, x);
+                        d <= b.max(tol)
+                    });
                 if ok && embedded_input {
                     let r = Replacement {
                         new_positions: Vec::new(),
@@ -1295,6 +1417,55 @@ fn smooth_pass(
         }
     }
     moved
+}
+
+/// The metric-optimal position of `v` (our addition, the anisotropic counterpart of the
+/// centroid): for every face `(v, a, b)` of its fan the apex that makes the face equilateral
+/// in the metric `m` at `v` (restricted to the fan's tangent plane), averaged over the fan.
+/// `None` when the plane or the metric there is degenerate.
+fn metric_optimal_point(
+    mesh: &TriMesh,
+    fan: &[FaceId],
+    v: VertexId,
+    m: &Matrix3<f64>,
+) -> Option<Point3<f64>> {
+    use nalgebra::{Matrix2, Vector2};
+    let n = fan
+        .iter()
+        .fold(Vector3::zeros(), |acc, f| acc + mesh.face_normal_raw(*f))
+        .try_normalize(1e-300)?;
+    let e1 = n
+        .cross(&Vector3::x())
+        .try_normalize(1e-6)
+        .or_else(|| n.cross(&Vector3::y()).try_normalize(1e-6))?;
+    let e2 = n.cross(&e1);
+    let m2 = Matrix2::new(
+        e1.dot(&(m * e1)),
+        e1.dot(&(m * e2)),
+        e2.dot(&(m * e1)),
+        e2.dot(&(m * e2)),
+    );
+    // Metric coordinates y = Lᵀx with M₂ = L Lᵀ (det L > 0 keeps orientations).
+    let l = m2.cholesky()?.l();
+    let lt = l.transpose();
+    let lt_inv = lt.try_inverse()?;
+    let o = mesh.positions[v.idx()];
+    let to2 = |p: &Point3<f64>| lt * Vector2::new((p - o).dot(&e1), (p - o).dot(&e2));
+    let mut sum = Vector2::zeros();
+    for f in fan {
+        let t = mesh.triangles[f.idx()];
+        let k = t.iter().position(|u| *u == v)?;
+        let (a, b) = (
+            to2(&mesh.positions[t[(k + 1) % 3].idx()]),
+            to2(&mesh.positions[t[(k + 2) % 3].idx()]),
+        );
+        // (p, a, b) counter-clockwise: p to the left of a → b.
+        let d = b - a;
+        sum += (a + b) * 0.5 + Vector2::new(-d.y, d.x) * (3f64.sqrt() / 2.0);
+    }
+    let x = lt_inv * (sum / fan.len() as f64);
+    let p = o + e1 * x.x + e2 * x.y;
+    p.coords.iter().all(|c| c.is_finite()).then_some(p)
 }
 
 /// Euclidean distance from `p` to the triangle `t` (parry's point-triangle projection).
@@ -1336,6 +1507,30 @@ fn segment_distance(a: Point3<f64>, b: Point3<f64>, c: Point3<f64>, d: Point3<f6
     ((a + u * s) - (c + v * t)).norm()
 }
 
+/// A corner vertex all of whose faces are in `faces` (interior to the patch), if any.
+fn interior_corner(
+    mesh: &TriMesh,
+    topo: &Topology,
+    faces: &[FaceId],
+    corners: &[bool],
+) -> Option<VertexId> {
+    let mut count: std::collections::HashMap<VertexId, usize> = std::collections::HashMap::new();
+    for &f in faces {
+        for v in mesh.face(f) {
+            if corners.get(v.idx()).copied().unwrap_or(false) {
+                *count.entry(v).or_default() += 1;
+            }
+        }
+    }
+    let mut inside: Vec<VertexId> = count
+        .into_iter()
+        .filter(|(v, n)| !topo.is_boundary_vertex(*v) && *n == topo.vertex_faces(*v).len())
+        .map(|(v, _)| v)
+        .collect();
+    inside.sort_unstable();
+    inside.first().copied()
+}
+
 /// A smaller disk inside `faces`: grown face by face (breadth first, exact disk rule) from
 /// `seed_face` if it is unprocessed, else from the first unprocessed face, up to `target`
 /// faces. Deterministic.
@@ -1345,6 +1540,7 @@ fn shrink_patch(
     faces: &[FaceId],
     seed_face: FaceId,
     target: usize,
+    corners: &[bool],
 ) -> Vec<FaceId> {
     let inside: HashSet<FaceId> = faces.iter().copied().collect();
     let start = if inside.contains(&seed_face) && !work.processed[seed_face.idx()] {
@@ -1360,6 +1556,7 @@ fn shrink_patch(
         topology: topo,
         processed: &work.processed,
         feature_edges: None,
+        corners: Some(corners),
     };
     let mut disk = DiskPatch::new(&ctx, start);
     let mut queue = std::collections::VecDeque::from([start]);
@@ -1642,6 +1839,31 @@ mod tests {
         (field, work, flip_test)
     }
 
+    /// A hexagon fan that is regular in the metric diag(4, 1, 0) (so squashed in x): with the
+    /// centre displaced, the metric-optimal point is the centre again, while the plain
+    /// centroid of a non-symmetric fan would not be.
+    #[test]
+    fn metric_optimal_point_recentres_an_anisotropic_fan() {
+        let m = Matrix3::from_diagonal(&Vector3::new(4.0, 1.0, 0.0));
+        let mut positions = vec![Point3::new(0.1, -0.2, 0.0)];
+        for k in 0..6 {
+            let a = std::f64::consts::FRAC_PI_3 * k as f64;
+            positions.push(Point3::new(0.5 * a.cos(), a.sin(), 0.0));
+        }
+        let triangles = (0..6)
+            .map(|k| [VertexId(0), VertexId(1 + k), VertexId(1 + (k + 1) % 6)])
+            .collect();
+        let mesh = TriMesh {
+            positions,
+            triangles,
+        };
+        let fan: Vec<FaceId> = (0..6).map(FaceId::new).collect();
+        let p = metric_optimal_point(&mesh, &fan, VertexId(0), &m).expect("point");
+        assert!(p.coords.norm() < 1e-12, "{p}");
+        // A degenerate tangent metric gives no point.
+        assert!(metric_optimal_point(&mesh, &fan, VertexId(0), &Matrix3::zeros()).is_none());
+    }
+
     /// The skinny pair is flipped to the short diagonal (q rises from 0.29 to 0.65) and the
     /// result is still an oriented disk over the same four vertices.
     #[test]
@@ -1718,7 +1940,7 @@ mod tests {
             let flip_test = FlipTest::new(&reference);
             let mut work = WorkingMesh::from_reference(&reference);
             let before = q_min(&work.mesh);
-            let moves = smooth_pass(&field, &flip_test, &mut work, true, tol);
+            let moves = smooth_pass(&field, &flip_test, &mut work, true, tol, &[]);
             let p = work.mesh.positions[0];
             let d = work
                 .mesh

@@ -116,6 +116,7 @@ fn patches_never_cross_feature_or_boundary_edges() {
     assert!(!features.is_empty());
     let opts = CoverOptions {
         feature_edges: Some(features.clone()),
+        corners: None,
         max_patches: None,
     };
     let mut rng = conemesh::Rng::seed_from_u64(2);
@@ -152,6 +153,7 @@ fn growth_respects_c_max_and_costs_are_recorded() {
         topology: &topo,
         processed: &processed,
         feature_edges: None,
+        corners: None,
     };
     let cone = conemesh::patches::fit_cone(&m, &[FaceId(0), FaceId(1)]);
     for c_max in [0.01, 0.1, 1.0] {

@@ -64,6 +64,10 @@ pub struct RemeshArgs {
     /// sweep's output with new patches, so the old patch seams get remeshed too.
     #[arg(long, default_value_t = RemeshOptions::default().sweeps)]
     pub sweeps: usize,
+    /// Keep input vertices whose angle defect |2π − angle sum| is at least this many radians
+    /// (tips, cone points, corners) as output vertices. 0 keeps none (the paper).
+    #[arg(long, default_value_t = 1.0)]
+    pub corner_defect: f64,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -152,6 +156,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
                 .unwrap_or_else(|| PathBuf::from("."))
         })),
         sweeps: args.sweeps,
+        corner_defect: (args.corner_defect != 0.0).then_some(args.corner_defect),
         ..RemeshOptions::default()
     };
     let total = field.reference().n_faces() as u64;

@@ -293,6 +293,22 @@ impl TriMesh {
         n
     }
 
+    /// Sum of the face corner angles at each vertex (radians). The angle defect of an interior
+    /// vertex is `2π − angle_sums[v]`: the discrete Gaussian curvature concentrated there.
+    pub fn angle_sums(&self) -> Vec<f64> {
+        let mut s = vec![0.0; self.n_vertices()];
+        for t in &self.triangles {
+            for k in 0..3 {
+                let p = self.positions[t[k].idx()];
+                let a = self.positions[t[(k + 1) % 3].idx()] - p;
+                let b = self.positions[t[(k + 2) % 3].idx()] - p;
+                // atan2 of cross and dot: accurate for angles near 0 and π too.
+                s[t[k].idx()] += a.cross(&b).norm().atan2(a.dot(&b));
+            }
+        }
+        s
+    }
+
     /// Mean edge length over all half-edges (each interior edge counted twice).
     pub fn mean_edge_length(&self) -> f64 {
         let mut s = 0.0;

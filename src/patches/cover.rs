@@ -19,6 +19,9 @@ pub struct CoverOptions {
     pub feature_edges: Option<HashSet<EdgeKey>>,
     /// Stop after this many patches (`None`: until covered). Default `None`.
     pub max_patches: Option<usize>,
+    /// Vertices no patch may contain in its interior ([`super::corner_vertices`]). Default
+    /// none.
+    pub corners: Option<Vec<bool>>,
 }
 
 /// Statistics of one patch.
@@ -84,6 +87,7 @@ pub fn cover(
             topology: &topology,
             processed: &processed,
             feature_edges: opts.feature_edges.as_ref(),
+            corners: opts.corners.as_deref(),
         };
         let patch = match strategy.next_patch(&ctx, rng) {
             Ok(Some(p)) => p,

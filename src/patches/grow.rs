@@ -41,6 +41,9 @@ pub enum Refusal {
     Feature(EdgeKey),
     /// A shared edge is not a manifold, consistently oriented mesh edge.
     NonManifold(EdgeKey),
+    /// It would close the fan of a corner vertex ([`PatchContext::corners`]), making it an
+    /// interior vertex of the patch.
+    Corner(VertexId),
 }
 
 /// A face set that is a topological disk by construction (the exact rule above), with the
@@ -149,6 +152,18 @@ impl<'c, 'a> DiskPatch<'c, 'a> {
             }
             if self.ctx.feature_edges.is_some_and(|fe| fe.contains(&key)) {
                 return Err(Refusal::Feature(key));
+            }
+        }
+        if shared > 0 && shared < 3 {
+            // A corner vertex becomes interior exactly when `t` is the last face of its fan.
+            for &v in &tri {
+                if self.ctx.is_corner(v)
+                    && !self.ctx.topology.is_boundary_vertex(v)
+                    && self.vertex_count.get(&v).copied().unwrap_or(0) as usize + 1
+                        == self.ctx.topology.vertex_faces(v).len()
+                {
+                    return Err(Refusal::Corner(v));
+                }
             }
         }
         match shared {

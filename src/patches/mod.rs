@@ -119,13 +119,42 @@ pub struct PatchContext<'a> {
     pub processed: &'a [bool],
     /// Edges patches must not cross (their interior may not contain them).
     pub feature_edges: Option<&'a HashSet<EdgeKey>>,
+    /// `corners[v]`: vertex `v` may not become an interior vertex of a patch (a cone point of
+    /// the input, see [`corner_vertices`]); vertices past the end are not corners.
+    pub corners: Option<&'a [bool]>,
+}
+
+impl PatchContext<'_> {
+    /// True when `v` is marked in [`PatchContext::corners`].
+    pub fn is_corner(&self, v: VertexId) -> bool {
+        self.corners
+            .is_some_and(|c| c.get(v.idx()).copied().unwrap_or(false))
+    }
+}
+
+/// Cone points of a piecewise-flat surface: interior vertices whose angle defect
+/// `|2π − Σθ|` is at least `min_defect` radians. The Gaussian curvature of the whole
+/// neighbourhood is concentrated at such a vertex, so no patch containing it in its interior
+/// can be flattened isometrically (Sec. 3.3), and the planar remesher would replace the tip
+/// by a flat fan, cutting it off (decimated-knight: spikes with defects of 3-4 rad, 2-5 % of
+/// the diagonal high). Patches keep them on their boundary, so they stay in the output.
+/// Boundary vertices are never interior to a patch and are not marked.
+pub fn corner_vertices(mesh: &TriMesh, topology: &Topology, min_defect: f64) -> Vec<bool> {
+    let sums = mesh.angle_sums();
+    mesh.vertices()
+        .map(|v| {
+            !topology.vertex_faces(v).is_empty()
+                && !topology.is_boundary_vertex(v)
+                && (std::f64::consts::TAU - sums[v.idx()]).abs() >= min_defect
+        })
+        .collect()
 }
 
 /// The research extension point of Sec. 3.2: produce the next patch to remesh.
 ///
 /// Contract: a returned patch is a topological disk (certified by the caller with
 /// `invariants::certify_disk`) containing at least one unprocessed face, does not cross
-/// feature edges, and its boundary loop is oriented as documented on [`Patch`]. `Ok(None)`
+/// feature edges, has no [`PatchContext::corners`] vertex in its interior, and its boundary loop is oriented as documented on [`Patch`]. `Ok(None)`
 /// means there is no unprocessed face left.
 pub trait PatchStrategy: Send + Sync {
     /// Short name (`cone`, …) used in reports and on the command line.
@@ -136,4 +165,90 @@ pub trait PatchStrategy: Send + Sync {
         ctx: &PatchContext<'_>,
         rng: &mut ChaCha8Rng,
     ) -> Result<Option<Patch>, PatchError>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generators;
+
+    /// The regular octahedron: every vertex has angle sum 4·60° and defect 2π/3.
+    fn octahedron() -> TriMesh {
+        let p = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let t = [
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        TriMesh::from_indices(
+            p.iter()
+                .map(|x| nalgebra::Point3::new(x[0], x[1], x[2]))
+                .collect(),
+            &t,
+        )
+        .expect("octahedron")
+    }
+
+    #[test]
+    fn corner_vertices_by_angle_defect() {
+        let o = octahedron();
+        let topo = Topology::build(&o);
+        let sums = o.angle_sums();
+        assert!(sums
+            .iter()
+            .all(|s| (s - 4.0 * std::f64::consts::FRAC_PI_3).abs() < 1e-12));
+        assert!(corner_vertices(&o, &topo, 2.0).iter().all(|c| *c));
+        assert!(corner_vertices(&o, &topo, 2.2).iter().all(|c| !*c));
+        // A finely sampled sphere has no cone points; a disk's rim vertices are never corners
+        // (boundary), and its flat centre has no defect.
+        let s = generators::icosphere(1.0, 3);
+        let ts = Topology::build(&s);
+        assert!(corner_vertices(&s, &ts, 0.2).iter().all(|c| !*c));
+        let d = generators::disk(1.0, 3, 6);
+        let td = Topology::build(&d);
+        assert!(corner_vertices(&d, &td, 1e-9).iter().all(|c| !*c));
+    }
+
+    #[test]
+    fn growth_never_closes_the_fan_of_a_corner() {
+        let o = octahedron();
+        let topo = Topology::build(&o);
+        let processed = vec![false; o.n_faces()];
+        let corners = vec![false, false, false, false, true, false];
+        let ctx = PatchContext {
+            mesh: &o,
+            topology: &topo,
+            processed: &processed,
+            feature_edges: None,
+            corners: Some(&corners),
+        };
+        // The four faces around vertex 4 in fan order: the last one would close its fan.
+        let fan = [FaceId(0), FaceId(1), FaceId(2), FaceId(3)];
+        let mut p = DiskPatch::new(&ctx, fan[0]);
+        assert_eq!(p.try_add(fan[1]), Ok(()));
+        assert_eq!(p.try_add(fan[2]), Ok(()));
+        assert_eq!(p.try_add(fan[3]), Err(Refusal::Corner(VertexId(4))));
+        // Without the mark the same face is accepted (k = 2 closes the fan: a disk).
+        let free = PatchContext {
+            corners: None,
+            ..ctx
+        };
+        let mut q = DiskPatch::new(&free, fan[0]);
+        for f in &fan[1..] {
+            assert_eq!(q.try_add(*f), Ok(()));
+        }
+        assert!(!ctx.is_corner(VertexId(99)), "past the end is not a corner");
+    }
 }
