@@ -281,10 +281,20 @@ impl Topology {
                 edges[self.face_component[h / 3] as usize] += 1;
             }
         }
+        // A vertex counts once in every component it belongs to (a pinch vertex joining
+        // two edge-connected components belongs to both).
+        let mut cs: Vec<u32> = Vec::new();
         for v in 0..self.n_vertices {
-            let fs = self.vertex_faces(VertexId::new(v));
-            if let Some(f) = fs.first() {
-                verts[self.face_component[f.idx()] as usize] += 1;
+            cs.clear();
+            cs.extend(
+                self.vertex_faces(VertexId::new(v))
+                    .iter()
+                    .map(|f| self.face_component[f.idx()]),
+            );
+            cs.sort_unstable();
+            cs.dedup();
+            for &c in &cs {
+                verts[c as usize] += 1;
             }
         }
         for &c in &self.boundary_loop_component {
@@ -421,7 +431,12 @@ impl Topology {
 
     /// Euler characteristic V − E + F of the referenced part of the mesh.
     pub fn euler_characteristic(&self) -> i64 {
-        self.components.iter().map(|c| c.euler).sum()
+        // V − E + F of the whole complex (a vertex shared by two components counts once
+        // here and once in each component's own χ).
+        let v = (0..self.n_vertices)
+            .filter(|&v| !self.vertex_faces(VertexId::new(v)).is_empty())
+            .count();
+        v as i64 - self.edges.len() as i64 + self.triangles.len() as i64
     }
 
     /// Edges with three or more faces, with their face count.
@@ -497,6 +512,39 @@ mod tests {
         let tt = Topology::build(&tor);
         assert_eq!(tt.components()[0].genus, Some(1));
         assert!(tt.boundary_loops().is_empty());
+    }
+
+    /// Two tetrahedra sharing one vertex: two components, each a sphere with its 4 vertices
+    /// (the shared vertex counts in both), while the whole complex has χ = 7 − 12 + 8 = 3.
+    #[test]
+    fn a_pinch_vertex_counts_in_both_components() {
+        let p = |x: f64, y: f64, z: f64| Point3::new(x, y, z);
+        let tet = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
+        let mut tris: Vec<[usize; 3]> = tet.to_vec();
+        // Second tetrahedron on vertices 0, 4, 5, 6 (vertex 0 shared).
+        let map = [0, 4, 5, 6];
+        tris.extend(tet.iter().map(|t| t.map(|i| map[i])));
+        let m = TriMesh::from_indices(
+            vec![
+                p(0.0, 0.0, 0.0),
+                p(1.0, 0.0, 0.0),
+                p(0.0, 1.0, 0.0),
+                p(0.0, 0.0, 1.0),
+                p(-1.0, 0.0, 0.0),
+                p(0.0, -1.0, 0.0),
+                p(0.0, 0.0, -1.0),
+            ],
+            &tris,
+        )
+        .expect("valid");
+        let t = Topology::build(&m);
+        assert_eq!(t.components().len(), 2);
+        for c in t.components() {
+            assert_eq!((c.faces, c.vertices, c.edges), (4, 4, 6));
+            assert_eq!((c.euler, c.genus), (2, Some(0)));
+        }
+        assert_eq!(t.euler_characteristic(), 3);
+        assert_eq!(t.non_manifold_vertices(), &[VertexId(0)]);
     }
 
     #[test]
