@@ -1183,7 +1183,6 @@ fn flip_pass(
     tol: f64,
 ) -> usize {
     use crate::quality::{face_metric, triangle_quality};
-    use crate::stitch::PatchVertex;
     let metrics: Vec<Matrix3<f64>> = work.locations.iter().map(|l| field.eval_at(l)).collect();
     let q = |mesh: &TriMesh, t: [VertexId; 3]| {
         triangle_quality(
@@ -1193,6 +1192,7 @@ fn flip_pass(
         .q
     };
     let mut total = 0;
+    let mut grid = FaceGrid::new(&work.mesh);
     for _pass in 0..8 {
         let mut edge_faces: std::collections::HashMap<EdgeKey, Vec<usize>> =
             std::collections::HashMap::new();
@@ -1256,20 +1256,22 @@ fn flip_pass(
             {
                 continue;
             }
-            if embedded_input {
-                let r = Replacement {
-                    new_positions: Vec::new(),
-                    new_locations: Vec::new(),
-                    triangles: vec![n1.map(PatchVertex::Existing), n2.map(PatchVertex::Existing)],
-                };
-                if certify_candidate_embedded(work, &[FaceId::new(f1), FaceId::new(f2)], &r)
-                    .is_err()
-                {
-                    continue;
-                }
+            if embedded_input
+                && !candidate_embedded_local(
+                    &work.mesh,
+                    &grid,
+                    &[FaceId::new(f1), FaceId::new(f2)],
+                    &[n1, n2],
+                )
+            {
+                continue;
             }
             work.mesh.triangles[f1] = n1;
             work.mesh.triangles[f2] = n2;
+            if let Some((lo, hi)) = bbox_of([a, b, c, d].iter().map(|v| p(*v))) {
+                grid.insert(f1, &lo, &hi);
+                grid.insert(f2, &lo, &hi);
+            }
             touched[f1] = true;
             touched[f2] = true;
             new_edges.insert(cd);
@@ -1301,10 +1303,10 @@ fn smooth_pass(
     corners: &[bool],
 ) -> usize {
     use crate::quality::{face_metric, triangle_quality};
-    use crate::stitch::PatchVertex;
     let topo = Topology::build(&work.mesh);
     let mut metrics: Vec<Matrix3<f64>> = work.locations.iter().map(|l| field.eval_at(l)).collect();
     let mut moved = 0;
+    let mut grid = FaceGrid::new(&work.mesh);
     for _pass in 0..3 {
         for vi in 0..work.mesh.n_vertices() {
             let v = VertexId::new(vi);
@@ -1393,17 +1395,16 @@ fn smooth_pass(
                         d <= b.max(tol)
                     });
                 if ok && embedded_input {
-                    let r = Replacement {
-                        new_positions: Vec::new(),
-                        new_locations: Vec::new(),
-                        triangles: fan
-                            .iter()
-                            .map(|f| work.mesh.triangles[f.idx()].map(PatchVertex::Existing))
-                            .collect(),
-                    };
-                    ok = certify_candidate_embedded(work, fan, &r).is_ok();
+                    let new_tris: Vec<[VertexId; 3]> =
+                        fan.iter().map(|f| work.mesh.triangles[f.idx()]).collect();
+                    ok = candidate_embedded_local(&work.mesh, &grid, fan, &new_tris);
                 }
                 if ok {
+                    for (f, t) in fan.iter().zip(&tris) {
+                        if let Some((lo, hi)) = bbox_of(t.iter().copied()) {
+                            grid.insert(f.idx(), &lo, &hi);
+                        }
+                    }
                     accepted = true;
                     break;
                 }
@@ -1691,6 +1692,113 @@ fn certify_candidate_embedded(
     }
 }
 
+/// A uniform grid over face bounding boxes, for the local self-intersection checks of the
+/// post-loop passes (a linear scan per flip or move made them O(F) each: 17 s of armadillo's
+/// run). A face is listed in every cell its box overlaps; boxes that grow (a moved vertex, a
+/// flipped pair) are added again without removing the old entries, so a query returns a
+/// superset of the faces whose current box overlaps, which the caller filters exactly.
+struct FaceGrid {
+    cell: f64,
+    cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl FaceGrid {
+    fn new(mesh: &TriMesh) -> FaceGrid {
+        let cell = (2.0 * mean_edge_length(mesh)).max(1e-12);
+        let mut g = FaceGrid {
+            cell,
+            cells: std::collections::HashMap::new(),
+        };
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            if let Some((lo, hi)) = bbox_of(t.iter().map(|v| mesh.positions[v.idx()])) {
+                g.insert(f, &lo, &hi);
+            }
+        }
+        g
+    }
+
+    fn key(&self, p: &Point3<f64>) -> [i64; 3] {
+        [0, 1, 2].map(|k| (p[k] / self.cell).floor() as i64)
+    }
+
+    fn insert(&mut self, f: usize, lo: &Point3<f64>, hi: &Point3<f64>) {
+        let (a, b) = (self.key(lo), self.key(hi));
+        for i in a[0]..=b[0] {
+            for j in a[1]..=b[1] {
+                for k in a[2]..=b[2] {
+                    self.cells.entry([i, j, k]).or_default().push(f as u32);
+                }
+            }
+        }
+    }
+
+    /// Faces listed in the cells the box overlaps, sorted, without repeats.
+    fn query(&self, lo: &Point3<f64>, hi: &Point3<f64>) -> Vec<usize> {
+        let (a, b) = (self.key(lo), self.key(hi));
+        let mut out = Vec::new();
+        for i in a[0]..=b[0] {
+            for j in a[1]..=b[1] {
+                for k in a[2]..=b[2] {
+                    if let Some(fs) = self.cells.get(&[i, j, k]) {
+                        out.extend(fs.iter().map(|f| *f as usize));
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+}
+
+/// [`certify_candidate_embedded`] for a replacement without new vertices (a flip or a move,
+/// with the working mesh already holding the moved positions), with the faces near the
+/// candidate taken from `grid`: the same faces in the same order, so the same verdict.
+fn candidate_embedded_local(
+    mesh: &TriMesh,
+    grid: &FaceGrid,
+    replaced: &[FaceId],
+    new_tris: &[[VertexId; 3]],
+) -> bool {
+    let p = |v: &VertexId| mesh.positions[v.idx()];
+    let Some((lo, hi)) = bbox_of(new_tris.iter().flatten().map(p)) else {
+        return true;
+    };
+    let mut tris: Vec<[VertexId; 3]> = new_tris.to_vec();
+    for f in grid.query(&lo, &hi) {
+        if f >= mesh.n_faces() || replaced.contains(&FaceId::new(f)) {
+            continue;
+        }
+        let t = mesh.triangles[f];
+        if let Some((a, b)) = bbox_of(t.iter().map(p)) {
+            if (0..3).all(|k| a[k] <= hi[k] && b[k] >= lo[k]) {
+                tris.push(t);
+            }
+        }
+    }
+    // Compact the vertices (ids only matter by equality in the exact test).
+    let mut local: std::collections::HashMap<VertexId, VertexId> = std::collections::HashMap::new();
+    let mut positions = Vec::new();
+    let triangles = tris
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                *local.entry(v).or_insert_with(|| {
+                    positions.push(p(&v));
+                    VertexId::new(positions.len() - 1)
+                })
+            })
+        })
+        .collect();
+    let n_new = new_tris.len();
+    invariants::self_intersections(&TriMesh {
+        positions,
+        triangles,
+    })
+    .into_iter()
+    .all(|(a, b)| a.idx() >= n_new && b.idx() >= n_new)
+}
+
 /// The working mesh's positions followed by the candidate's new vertices, and the candidate's
 /// triangles in those ids (new vertex `i` is `n_vertices + i`).
 fn candidate_arrays(
@@ -1837,6 +1945,52 @@ mod tests {
         let work = WorkingMesh::from_reference(&reference);
         let flip_test = FlipTest::new(&reference);
         (field, work, flip_test)
+    }
+
+    /// The grid-based local check gives the same verdict as the full scan, on moves that
+    /// push a torus vertex through the opposite side of the tube (intersecting) and on small
+    /// moves (not intersecting).
+    #[test]
+    fn local_embedding_check_agrees_with_the_full_scan() {
+        use crate::stitch::PatchVertex;
+        let torus = crate::mesh::generators::torus(1.0, 0.3, 24, 12);
+        let mut work = WorkingMesh::from_reference(&torus);
+        let topo = Topology::build(&work.mesh);
+        let grid = FaceGrid::new(&work.mesh);
+        let (mut hits, mut misses) = (0, 0);
+        for vi in (0..work.mesh.n_vertices()).step_by(7) {
+            let v = VertexId::new(vi);
+            let fan = topo.vertex_faces(v).to_vec();
+            let old = work.mesh.positions[vi];
+            // Towards the tube's centre line: 2.5 pierces the far wall, 0.05 stays near.
+            let centre = Point3::from(Vector3::new(old.x, old.y, 0.0).normalize());
+            for t in [0.05, 2.5] {
+                work.mesh.positions[vi] = old + (centre - old) * t;
+                let new_tris: Vec<[VertexId; 3]> =
+                    fan.iter().map(|f| work.mesh.triangles[f.idx()]).collect();
+                let r = Replacement {
+                    new_positions: Vec::new(),
+                    new_locations: Vec::new(),
+                    triangles: new_tris
+                        .iter()
+                        .map(|t| t.map(PatchVertex::Existing))
+                        .collect(),
+                };
+                let full = certify_candidate_embedded(&work, &fan, &r).is_ok();
+                let local = candidate_embedded_local(&work.mesh, &grid, &fan, &new_tris);
+                assert_eq!(full, local, "v{vi} t {t}");
+                if full {
+                    misses += 1
+                } else {
+                    hits += 1
+                }
+            }
+            work.mesh.positions[vi] = old;
+        }
+        assert!(
+            hits > 0 && misses > 0,
+            "both verdicts exercised: {hits} / {misses}"
+        );
     }
 
     /// A hexagon fan that is regular in the metric diag(4, 1, 0) (so squashed in x): with the
