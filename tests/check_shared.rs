@@ -151,4 +151,12 @@ fn cli_exit_codes_and_json() {
     );
     let (code, _) = run_cli(&["/nonexistent/mesh.off"]);
     assert_eq!(code, Some(2));
+    // The OS error is named once (it is part of the message, not a second link of the chain).
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_conemesh"))
+        .args(["check", "/nonexistent/mesh.off"])
+        .output()
+        .expect("the conemesh binary runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("os error").count(), 1, "{err}");
+    assert!(err.contains("/nonexistent/mesh.off"), "{err}");
 }

@@ -49,13 +49,14 @@ fn loc(line: &usize) -> String {
 /// own order).
 #[derive(Debug, Error)]
 pub enum IoError {
-    /// Operating-system error on a path.
-    #[error("{path}: {source}")]
+    /// Operating-system error on a path. The OS error is part of the message and not a
+    /// `source()`, so error chains (`anyhow`'s `{:#}`) do not print it twice.
+    #[error("{path}: {error}")]
     Os {
         /// the file
         path: String,
         /// the OS error
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file extension names no supported format.
     #[error("{path}: unsupported format (expected .obj, .off, .ply, .stl or .mesh)")]
@@ -299,9 +300,9 @@ pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
     let p = path.display().to_string();
     let format =
         Format::from_path(path).ok_or_else(|| IoError::UnsupportedFormat { path: p.clone() })?;
-    let bytes = std::fs::read(path).map_err(|source| IoError::Os {
+    let bytes = std::fs::read(path).map_err(|error| IoError::Os {
         path: p.clone(),
-        source,
+        error,
     })?;
     read_mesh_bytes(&bytes, format, &p)
 }
@@ -411,9 +412,9 @@ fn write_atomic(
     body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), IoError> {
     let p = path.display().to_string();
-    let os = |source: std::io::Error| IoError::Os {
+    let os = |error: std::io::Error| IoError::Os {
         path: p.clone(),
-        source,
+        error,
     };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,

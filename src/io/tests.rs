@@ -367,9 +367,9 @@ fn sample() -> TriMesh {
 
 #[test]
 fn writers_round_trip_bit_exact() -> Result<(), IoError> {
-    let dir = tempfile::tempdir().map_err(|source| IoError::Os {
+    let dir = tempfile::tempdir().map_err(|error| IoError::Os {
         path: "tmp".into(),
-        source,
+        error,
     })?;
     let m = sample();
     let n = m.n_faces();
