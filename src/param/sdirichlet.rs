@@ -100,6 +100,10 @@ pub struct SdOptions {
     pub collision_rounds: usize,
     /// Stiffness of an active pair relative to the mean Hessian diagonal [1e3].
     pub collision_stiffness: f64,
+    /// Also stop when the Newton decrement `−∇E·d` of the current direction (twice the
+    /// decrease the quadratic model predicts for the full step) is below this fraction of
+    /// the energy excess `E − 4` [0: off].
+    pub decrement_tol: f64,
 }
 
 impl Default for SdOptions {
@@ -122,6 +126,7 @@ impl Default for SdOptions {
             collision_active_below: 0.0,
             collision_rounds: 2,
             collision_stiffness: 1e3,
+            decrement_tol: 3e-3,
         }
     }
 }
@@ -144,6 +149,9 @@ pub struct SdLog {
     pub steps: Vec<f64>,
     /// Largest flip-free step (before `step_fraction`) of each iteration.
     pub flip_free_steps: Vec<f64>,
+    /// Newton decrement `−∇E·d` of each iteration's direction `d` (twice the decrease the
+    /// quadratic model predicts for the full step).
+    pub decrements: Vec<f64>,
     /// Line-search trials rejected by the Armijo test (or an infinite energy).
     pub armijo_rejections: usize,
     /// Newton iterations taken.
@@ -1157,6 +1165,10 @@ fn newton(
             converged = true; // no descent direction left
             break;
         }
+        if certified && -slope < options.decrement_tol * (energy - 4.0).max(0.0) {
+            converged = true;
+            break;
+        }
         let mut t_flip = prob.max_flip_free_step(&uv, &dir);
         // Boundary-collision bound over the steps the first trial can reach (the
         // extrapolation beyond it is judged by the certificate alone).
@@ -1266,6 +1278,7 @@ fn newton(
         abs_twist = options.abs_twist && t < 1.0;
         log.steps.push(t);
         log.flip_free_steps.push(t_flip);
+        log.decrements.push(-slope);
         log.energies.push(e_new);
         log.min_double_area
             .push(min_double_area(&uv, &disk.triangles));
@@ -1333,33 +1346,53 @@ pub fn initial_map(
     boundary: &[VertexId],
     options: &SdOptions,
 ) -> Result<(Vec<Point2<f64>>, InitialMap), ParamError> {
-    initial_map_with(disk, boundary, options, &OnceCell::new())
+    initial_map_with(
+        disk,
+        boundary,
+        options,
+        &OnceCell::new(),
+        &mut SdProfile::default(),
+    )
 }
 
-/// [`initial_map`] with the Newton setup shared with the optimisation that follows.
+/// [`initial_map`] with the Newton setup shared with the optimisation that follows; fills
+/// the start-up part of `prof`.
 fn initial_map_with(
     disk: &TriMesh,
     boundary: &[VertexId],
     options: &SdOptions,
     setup: &OnceCell<Setup>,
+    prof: &mut SdProfile,
 ) -> Result<(Vec<Point2<f64>>, InitialMap), ParamError> {
+    let clock = std::time::Instant::now();
+    let ms = |c: std::time::Instant| c.elapsed().as_secs_f64() * 1e3;
     if options.free_boundary_init {
         let lscm = Setup::get(setup, disk).and_then(|s| lscm_shared(disk, boundary, s));
         if let Ok(mut uv) = lscm {
             scale_to_area(disk, &mut uv);
-            if certify(disk, &uv, boundary).is_ok() {
+            let lscm_ok = certify(disk, &uv, boundary).is_ok();
+            prof.lscm_ms = ms(clock);
+            if lscm_ok {
                 return Ok((uv, InitialMap::Lscm));
             }
             if options.repair_iters > 0 {
+                let clock = std::time::Instant::now();
                 let o = SdOptions {
                     max_iters: options.repair_iters,
                     ..*options
                 };
-                if let Ok((mut r, _)) = newton(disk, boundary, &uv, &o, false, setup) {
+                let repaired = newton(disk, boundary, &uv, &o, false, setup);
+                let mut out = None;
+                if let Ok((mut r, log)) = repaired {
+                    prof.repair = Some(log);
                     scale_to_area(disk, &mut r);
                     if certify(disk, &r, boundary).is_ok() {
-                        return Ok((r, InitialMap::RepairedLscm));
+                        out = Some(r);
                     }
+                }
+                prof.repair_ms = ms(clock);
+                if let Some(r) = out {
+                    return Ok((r, InitialMap::RepairedLscm));
                 }
             }
             if options.shaped_tutte_init {
@@ -1392,9 +1425,44 @@ impl Parameterizer for SymmetricDirichlet {
         disk: &TriMesh,
         boundary: &[VertexId],
     ) -> Result<Parameterization, ParamError> {
+        self.parameterize_profiled(disk, boundary).map(|r| r.0)
+    }
+}
+
+/// Where the time of one [`SymmetricDirichlet::parameterize_profiled`] call went.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SdProfile {
+    /// The initial map chosen.
+    pub init: Option<InitialMap>,
+    /// Newton setup, LSCM and its certificate, ms.
+    pub lscm_ms: f64,
+    /// Overlap repair and the certificate of its result, ms (0 when not run).
+    pub repair_ms: f64,
+    /// Log of the overlap repair, when it ran.
+    pub repair: Option<SdLog>,
+    /// Whole initial map (including any Tutte fallback), ms.
+    pub init_ms: f64,
+    /// Log of the certified Newton optimisation.
+    pub newton: SdLog,
+    /// Certified Newton optimisation, ms.
+    pub newton_ms: f64,
+}
+
+impl SymmetricDirichlet {
+    /// [`Parameterizer::parameterize`], also returning where the time went.
+    pub fn parameterize_profiled(
+        &self,
+        disk: &TriMesh,
+        boundary: &[VertexId],
+    ) -> Result<(Parameterization, SdProfile), ParamError> {
         validate_disk(disk, boundary)?;
+        let mut prof = SdProfile::default();
+        let clock = std::time::Instant::now();
         let setup = OnceCell::new();
-        let (uv0, _) = initial_map_with(disk, boundary, &self.options, &setup)?;
+        let (uv0, kind) = initial_map_with(disk, boundary, &self.options, &setup, &mut prof)?;
+        prof.init = Some(kind);
+        prof.init_ms = clock.elapsed().as_secs_f64() * 1e3;
+        let clock = std::time::Instant::now();
         // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
         // finite float energy, or a failed factorisation), the certified Tutte map is returned.
         // `initial_map_with` certified `uv0`.
@@ -1408,6 +1476,7 @@ impl Parameterizer for SymmetricDirichlet {
                 },
             ),
         };
+        prof.newton_ms = clock.elapsed().as_secs_f64() * 1e3;
         let mut fell_back = log.fell_back;
         // Isometric in the mean: rescale so the 2D area equals the 3D area; a uniform scale
         // keeps orientations in exact arithmetic, and the certificate is re-checked.
@@ -1421,7 +1490,8 @@ impl Parameterizer for SymmetricDirichlet {
         report.iterations = log.iterations;
         report.hit_budget = log.hit_budget;
         report.fell_back = fell_back;
-        Ok(Parameterization { uv, report })
+        prof.newton = log;
+        Ok((Parameterization { uv, report }, prof))
     }
 }
 
