@@ -17,6 +17,8 @@
 //! * Start: the free-boundary LSCM when certified; else the LSCM after the overlap repair
 //!   (`repair_iters`) when that is certified; else the Tutte map. The repair steps are part
 //!   of computing the start: only the certified start and the iterates after it count.
+//! * Stopping: a step whose decrease is below `rel_tol` of the excess `E − 4`, or a Newton
+//!   direction whose predicted decrease (the decrement) is below `decrement_tol` of it.
 //! * Line search: the largest flip-free step (smallest positive root of `det J(t) = 0` over
 //!   all triangles) times `step_fraction`, then Armijo backtracking; a trial is accepted only
 //!   if `certify_bijective` (exact) passes, so every iterate is certified.
@@ -100,9 +102,14 @@ pub struct SdOptions {
     pub collision_rounds: usize,
     /// Stiffness of an active pair relative to the mean Hessian diagonal [1e3].
     pub collision_stiffness: f64,
-    /// Also stop when the Newton decrement `−∇E·d` of the current direction (twice the
-    /// decrease the quadratic model predicts for the full step) is below this fraction of
-    /// the energy excess `E − 4` [0: off].
+    /// Also stop, before the line search, when the Newton decrement `−∇E·d` of the current
+    /// direction `d` (twice the decrease the quadratic model predicts for the full step) is
+    /// below this fraction of the energy excess `E − 4` [3e-3; 0 disables]. Unlike
+    /// `rel_tol`, which judges the decrease a step achieved, this judges what is left, so
+    /// a step shortened by the collision bound (small achieved decrease, large decrement)
+    /// does not stop the iteration, while the tail of tiny full steps near the optimum is
+    /// skipped: over all cover patches of the shared meshes 28% fewer iterations with the
+    /// same area-weighted mean and worst max σ1/σ2 per mesh (paper-notes, Sec. 3.3).
     pub decrement_tol: f64,
 }
 
@@ -1165,7 +1172,11 @@ fn newton(
             converged = true; // no descent direction left
             break;
         }
-        if certified && -slope < options.decrement_tol * (energy - 4.0).max(0.0) {
+        // What is left to gain: the quadratic model predicts −slope/2 for the full step.
+        // Trusted only when the twist is clamped (`abs_twist` off: the last step was full),
+        // since the absolute-value filter inflates the model's curvature and so shrinks the
+        // decrement. Not in the overlap repair, which stops on its own rule.
+        if certified && !abs_twist && -slope < options.decrement_tol * (energy - 4.0).max(0.0) {
             converged = true;
             break;
         }
@@ -1661,6 +1672,44 @@ mod tests {
             .map(|(p, q)| (p - q).norm())
             .fold(0.0, f64::max);
         assert!(err < 1e-9, "{err}");
+    }
+
+    #[test]
+    fn decrement_stop_skips_only_the_tail() {
+        // A spherical cap (not developable: the optimum keeps an excess E − 4 > 0) from its
+        // circle Tutte map.
+        let mut disk = crate::mesh::generators::disk(1.0, 12, 6);
+        for p in &mut disk.positions {
+            p.z = (4.0 - p.x * p.x - p.y * p.y).sqrt();
+        }
+        let boundary = super::super::disk_boundary(&disk).unwrap();
+        let (uv0, _) = certified_tutte(&disk, &boundary, TutteWeights::Cotan).unwrap();
+        let run = |decrement_tol: f64| {
+            let o = SdOptions {
+                decrement_tol,
+                ..Default::default()
+            };
+            newton(&disk, &boundary, &uv0, &o, true, &OnceCell::new()).unwrap()
+        };
+        let (uv_full, full) = run(0.0);
+        let (uv_tail, tail) = run(SdOptions::default().decrement_tol);
+        crate::invariants::certify_bijective(&uv_tail, &disk.triangles, &boundary).unwrap();
+        crate::invariants::certify_bijective(&uv_full, &disk.triangles, &boundary).unwrap();
+        // Same trajectory up to the stop, so never more iterations, and it stops early here.
+        assert!(
+            tail.iterations < full.iterations,
+            "{} {}",
+            tail.iterations,
+            full.iterations
+        );
+        assert_eq!(tail.energies[..], full.energies[..tail.energies.len()]);
+        // What it skips is below the predicted remainder (a few 1e-3 of the excess).
+        let (et, ef) = (
+            *tail.energies.last().unwrap(),
+            *full.energies.last().unwrap(),
+        );
+        assert!(!tail.hit_budget && !tail.fell_back);
+        assert!(et - ef <= 1e-2 * (et - 4.0), "{et} {ef}");
     }
 
     #[test]
