@@ -223,15 +223,26 @@ impl Pattern {
             let k = row_idx[s..e].binary_search(&row).unwrap_or(0);
             (s + k) as u32
         };
+        // Column `2a + c` lists rows `2w, 2w + 1` for the sorted neighbours `w` of `a`, so the
+        // slot of row `2b + r` is `col_ptr[2a + c] + 2·(position of b in adj[a]) + r`: one
+        // search per vertex pair instead of one per entry.
         let tri_slots = tris
             .iter()
             .map(|t| {
                 let mut s = [0u32; 36];
-                for l1 in 0..6 {
-                    for l2 in 0..6 {
-                        let r = 2 * t[l1 / 2].idx() + l1 % 2;
-                        let c = 2 * t[l2 / 2].idx() + l2 % 2;
-                        s[l1 * 6 + l2] = slot(r, c);
+                for k1 in 0..3 {
+                    let a = t[k1].idx();
+                    for k2 in 0..3 {
+                        let b = t[k2].idx();
+                        // By construction b is in adj[a].
+                        let pos = adj[a].binary_search(&b).unwrap_or(0);
+                        for c in 0..2 {
+                            let base = col_ptr[2 * a + c] + 2 * pos;
+                            for r in 0..2 {
+                                // Entry (row 2b + r, column 2a + c) at local (2k2 + r, 2k1 + c).
+                                s[(2 * k2 + r) * 6 + 2 * k1 + c] = (base + r) as u32;
+                            }
+                        }
                     }
                 }
                 s
@@ -1710,6 +1721,23 @@ mod tests {
         );
         assert!(!tail.hit_budget && !tail.fell_back);
         assert!(et - ef <= 1e-2 * (et - 4.0), "{et} {ef}");
+    }
+
+    #[test]
+    fn triangle_slots_address_their_entries() {
+        let disk = crate::mesh::generators::disk(1.0, 5, 5);
+        let pat = Pattern::new(disk.n_vertices(), &disk.triangles);
+        for (t, slots) in disk.triangles.iter().zip(&pat.tri_slots) {
+            for l1 in 0..6 {
+                for l2 in 0..6 {
+                    let row = 2 * t[l1 / 2].idx() + l1 % 2;
+                    let col = 2 * t[l2 / 2].idx() + l2 % 2;
+                    let k = slots[l1 * 6 + l2] as usize;
+                    assert!(pat.col_ptr[col] <= k && k < pat.col_ptr[col + 1]);
+                    assert_eq!(pat.row_idx[k], row);
+                }
+            }
+        }
     }
 
     #[test]
