@@ -46,7 +46,7 @@ fn main() {
             continue;
         };
         for (pi, p) in run.patches.iter().enumerate() {
-            if p.faces.len() < minf {
+            if p.faces.len() < minf || p.faces.len() > env_usize("MAXF").unwrap_or(usize::MAX) {
                 continue;
             }
             let Ok(pm) = extract_patch(&mesh, &p.faces) else {
@@ -67,28 +67,89 @@ fn main() {
             }
             // REPS=n: best-of-n wall time of the default parameterizer (initial map included).
             if let Some(reps) = env_usize("REPS") {
-                use conemesh::param::Parameterizer;
                 let mut best = f64::INFINITY;
                 let mut rep = None;
+                let mut best_prof = None;
                 for _ in 0..reps {
                     let t = Instant::now();
                     let mut sd = conemesh::param::SymmetricDirichlet::default();
                     if let Some(x) = env_usize("RI") {
                         sd.options.repair_iters = x;
                     }
-                    let r = sd.parameterize(&pm.mesh, &pm.boundary);
-                    best = best.min(t.elapsed().as_secs_f64() * 1e3);
-                    rep = r.ok().map(|p| p.report);
+                    let env = |k: &str| std::env::var(k).ok().and_then(|s| s.parse::<f64>().ok());
+                    if let Some(x) = env("RM") {
+                        sd.options.repair_margin = x;
+                    }
+                    if let Some(x) = env("RT") {
+                        sd.options.rel_tol = x;
+                    }
+                    if let Some(x) = env("BD") {
+                        sd.options.barrier_distance = x;
+                    }
+                    if let Some(x) = env("DT") {
+                        sd.options.decrement_tol = x;
+                    }
+                    if let Some(x) = env("COLL") {
+                        sd.options.collision_bound = x > 0.0;
+                    }
+                    if let Some(x) = env("SF") {
+                        sd.options.step_fraction = x;
+                    }
+                    if let Some(x) = env("BW") {
+                        sd.options.barrier_weight = x;
+                    }
+                    if let Some(x) = env("RW") {
+                        sd.options.repair_weight = x;
+                    }
+                    let r = sd.parameterize_profiled(&pm.mesh, &pm.boundary);
+                    let ms = t.elapsed().as_secs_f64() * 1e3;
+                    if let Ok((p, prof)) = r {
+                        if ms < best {
+                            best_prof = Some(prof);
+                        }
+                        rep = Some(p.report);
+                    }
+                    best = best.min(ms);
                 }
                 if let Some(r) = rep {
                     println!(
-                        "{name} p{pi} {}f: best of {reps} {best:.1} ms, it {} budget {} meanc {:.4} maxc {:.3}",
+                        "{name} p{pi} {}f: best of {reps} {best:.1} ms, it {} budget {} meanc {:.4} maxc {:.3} fb {}",
                         p.faces.len(),
                         r.iterations,
                         r.hit_budget,
                         r.mean_conformal,
-                        r.max_conformal
+                        r.max_conformal,
+                        r.fell_back
                     );
+                }
+                if let (Some(pr), true) = (best_prof, verbose) {
+                    let l = &pr.newton;
+                    println!(
+                        "  init {:?} {:.1} ms (lscm {:.1}, repair {:.1} it {:?}), newton {:.1} ms split {:.1?} it {} fact {} armijo {} cert {} coll {}",
+                        pr.init,
+                        pr.init_ms,
+                        pr.lscm_ms,
+                        pr.repair_ms,
+                        pr.repair.as_ref().map(|r| (r.iterations, r.time_ms.map(|x| (x * 10.0).round() / 10.0))),
+                        pr.newton_ms,
+                        l.time_ms,
+                        l.iterations,
+                        l.factorizations,
+                        l.armijo_rejections,
+                        l.certificate_rejections,
+                        l.collision_limited
+                    );
+                    for i in 0..l.steps.len() {
+                        println!(
+                            "    {:2} E {:.6} dec/exc {:.2e} rel {:.2e} step {:.4} flipfree {:.4}",
+                            i + 1,
+                            l.energies[i + 1],
+                            l.decrements[i] / (l.energies[i] - 4.0),
+                            (l.energies[i] - l.energies[i + 1]) / (l.energies[i] - 4.0),
+                            l.steps[i],
+                            l.flip_free_steps[i]
+                        );
+                    }
                 }
                 continue;
             }

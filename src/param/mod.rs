@@ -11,7 +11,7 @@ pub use distortion::{distortion, triangle_frames, TriangleFrame};
 pub use lscm::lscm;
 pub use sdirichlet::{
     initial_map, optimize_locally_injective, optimize_with_log, InitialMap, SdLog, SdOptions,
-    SymmetricDirichlet,
+    SdProfile, SymmetricDirichlet,
 };
 pub use shaped::ellipse_boundary;
 pub use tutte::{circle_boundary, scale_to_area, tutte_embedding, Tutte, TutteWeights};

@@ -17,6 +17,8 @@
 //! * Start: the free-boundary LSCM when certified; else the LSCM after the overlap repair
 //!   (`repair_iters`) when that is certified; else the Tutte map. The repair steps are part
 //!   of computing the start: only the certified start and the iterates after it count.
+//! * Stopping: a step whose decrease is below `rel_tol` of the excess `E − 4`, or a Newton
+//!   direction whose predicted decrease (the decrement) is below `decrement_tol` of it.
 //! * Line search: the largest flip-free step (smallest positive root of `det J(t) = 0` over
 //!   all triangles) times `step_fraction`, then Armijo backtracking; a trial is accepted only
 //!   if `certify_bijective` (exact) passes, so every iterate is certified.
@@ -100,6 +102,15 @@ pub struct SdOptions {
     pub collision_rounds: usize,
     /// Stiffness of an active pair relative to the mean Hessian diagonal [1e3].
     pub collision_stiffness: f64,
+    /// Also stop, before the line search, when the Newton decrement `−∇E·d` of the current
+    /// direction `d` (twice the decrease the quadratic model predicts for the full step) is
+    /// below this fraction of the energy excess `E − 4` [3e-3; 0 disables]. Unlike
+    /// `rel_tol`, which judges the decrease a step achieved, this judges what is left, so
+    /// a step shortened by the collision bound (small achieved decrease, large decrement)
+    /// does not stop the iteration, while the tail of tiny full steps near the optimum is
+    /// skipped: over all cover patches of the shared meshes 28% fewer iterations with the
+    /// same area-weighted mean and worst max σ1/σ2 per mesh (paper-notes, Sec. 3.3).
+    pub decrement_tol: f64,
 }
 
 impl Default for SdOptions {
@@ -122,6 +133,7 @@ impl Default for SdOptions {
             collision_active_below: 0.0,
             collision_rounds: 2,
             collision_stiffness: 1e3,
+            decrement_tol: 3e-3,
         }
     }
 }
@@ -144,6 +156,9 @@ pub struct SdLog {
     pub steps: Vec<f64>,
     /// Largest flip-free step (before `step_fraction`) of each iteration.
     pub flip_free_steps: Vec<f64>,
+    /// Newton decrement `−∇E·d` of each iteration's direction `d` (twice the decrease the
+    /// quadratic model predicts for the full step).
+    pub decrements: Vec<f64>,
     /// Line-search trials rejected by the Armijo test (or an infinite energy).
     pub armijo_rejections: usize,
     /// Newton iterations taken.
@@ -208,15 +223,26 @@ impl Pattern {
             let k = row_idx[s..e].binary_search(&row).unwrap_or(0);
             (s + k) as u32
         };
+        // Column `2a + c` lists rows `2w, 2w + 1` for the sorted neighbours `w` of `a`, so the
+        // slot of row `2b + r` is `col_ptr[2a + c] + 2·(position of b in adj[a]) + r`: one
+        // search per vertex pair instead of one per entry.
         let tri_slots = tris
             .iter()
             .map(|t| {
                 let mut s = [0u32; 36];
-                for l1 in 0..6 {
-                    for l2 in 0..6 {
-                        let r = 2 * t[l1 / 2].idx() + l1 % 2;
-                        let c = 2 * t[l2 / 2].idx() + l2 % 2;
-                        s[l1 * 6 + l2] = slot(r, c);
+                for k1 in 0..3 {
+                    let a = t[k1].idx();
+                    for k2 in 0..3 {
+                        let b = t[k2].idx();
+                        // By construction b is in adj[a].
+                        let pos = adj[a].binary_search(&b).unwrap_or(0);
+                        for c in 0..2 {
+                            let base = col_ptr[2 * a + c] + 2 * pos;
+                            for r in 0..2 {
+                                // Entry (row 2b + r, column 2a + c) at local (2k2 + r, 2k1 + c).
+                                s[(2 * k2 + r) * 6 + 2 * k1 + c] = (base + r) as u32;
+                            }
+                        }
                     }
                 }
                 s
@@ -1157,6 +1183,14 @@ fn newton(
             converged = true; // no descent direction left
             break;
         }
+        // What is left to gain: the quadratic model predicts −slope/2 for the full step.
+        // Trusted only when the twist is clamped (`abs_twist` off: the last step was full),
+        // since the absolute-value filter inflates the model's curvature and so shrinks the
+        // decrement. Not in the overlap repair, which stops on its own rule.
+        if certified && !abs_twist && -slope < options.decrement_tol * (energy - 4.0).max(0.0) {
+            converged = true;
+            break;
+        }
         let mut t_flip = prob.max_flip_free_step(&uv, &dir);
         // Boundary-collision bound over the steps the first trial can reach (the
         // extrapolation beyond it is judged by the certificate alone).
@@ -1266,6 +1300,7 @@ fn newton(
         abs_twist = options.abs_twist && t < 1.0;
         log.steps.push(t);
         log.flip_free_steps.push(t_flip);
+        log.decrements.push(-slope);
         log.energies.push(e_new);
         log.min_double_area
             .push(min_double_area(&uv, &disk.triangles));
@@ -1333,33 +1368,53 @@ pub fn initial_map(
     boundary: &[VertexId],
     options: &SdOptions,
 ) -> Result<(Vec<Point2<f64>>, InitialMap), ParamError> {
-    initial_map_with(disk, boundary, options, &OnceCell::new())
+    initial_map_with(
+        disk,
+        boundary,
+        options,
+        &OnceCell::new(),
+        &mut SdProfile::default(),
+    )
 }
 
-/// [`initial_map`] with the Newton setup shared with the optimisation that follows.
+/// [`initial_map`] with the Newton setup shared with the optimisation that follows; fills
+/// the start-up part of `prof`.
 fn initial_map_with(
     disk: &TriMesh,
     boundary: &[VertexId],
     options: &SdOptions,
     setup: &OnceCell<Setup>,
+    prof: &mut SdProfile,
 ) -> Result<(Vec<Point2<f64>>, InitialMap), ParamError> {
+    let clock = std::time::Instant::now();
+    let ms = |c: std::time::Instant| c.elapsed().as_secs_f64() * 1e3;
     if options.free_boundary_init {
         let lscm = Setup::get(setup, disk).and_then(|s| lscm_shared(disk, boundary, s));
         if let Ok(mut uv) = lscm {
             scale_to_area(disk, &mut uv);
-            if certify(disk, &uv, boundary).is_ok() {
+            let lscm_ok = certify(disk, &uv, boundary).is_ok();
+            prof.lscm_ms = ms(clock);
+            if lscm_ok {
                 return Ok((uv, InitialMap::Lscm));
             }
             if options.repair_iters > 0 {
+                let clock = std::time::Instant::now();
                 let o = SdOptions {
                     max_iters: options.repair_iters,
                     ..*options
                 };
-                if let Ok((mut r, _)) = newton(disk, boundary, &uv, &o, false, setup) {
+                let repaired = newton(disk, boundary, &uv, &o, false, setup);
+                let mut out = None;
+                if let Ok((mut r, log)) = repaired {
+                    prof.repair = Some(log);
                     scale_to_area(disk, &mut r);
                     if certify(disk, &r, boundary).is_ok() {
-                        return Ok((r, InitialMap::RepairedLscm));
+                        out = Some(r);
                     }
+                }
+                prof.repair_ms = ms(clock);
+                if let Some(r) = out {
+                    return Ok((r, InitialMap::RepairedLscm));
                 }
             }
             if options.shaped_tutte_init {
@@ -1392,9 +1447,44 @@ impl Parameterizer for SymmetricDirichlet {
         disk: &TriMesh,
         boundary: &[VertexId],
     ) -> Result<Parameterization, ParamError> {
+        self.parameterize_profiled(disk, boundary).map(|r| r.0)
+    }
+}
+
+/// Where the time of one [`SymmetricDirichlet::parameterize_profiled`] call went.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SdProfile {
+    /// The initial map chosen.
+    pub init: Option<InitialMap>,
+    /// Newton setup, LSCM and its certificate, ms.
+    pub lscm_ms: f64,
+    /// Overlap repair and the certificate of its result, ms (0 when not run).
+    pub repair_ms: f64,
+    /// Log of the overlap repair, when it ran.
+    pub repair: Option<SdLog>,
+    /// Whole initial map (including any Tutte fallback), ms.
+    pub init_ms: f64,
+    /// Log of the certified Newton optimisation.
+    pub newton: SdLog,
+    /// Certified Newton optimisation, ms.
+    pub newton_ms: f64,
+}
+
+impl SymmetricDirichlet {
+    /// [`Parameterizer::parameterize`], also returning where the time went.
+    pub fn parameterize_profiled(
+        &self,
+        disk: &TriMesh,
+        boundary: &[VertexId],
+    ) -> Result<(Parameterization, SdProfile), ParamError> {
         validate_disk(disk, boundary)?;
+        let mut prof = SdProfile::default();
+        let clock = std::time::Instant::now();
         let setup = OnceCell::new();
-        let (uv0, _) = initial_map_with(disk, boundary, &self.options, &setup)?;
+        let (uv0, kind) = initial_map_with(disk, boundary, &self.options, &setup, &mut prof)?;
+        prof.init = Some(kind);
+        prof.init_ms = clock.elapsed().as_secs_f64() * 1e3;
+        let clock = std::time::Instant::now();
         // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
         // finite float energy, or a failed factorisation), the certified Tutte map is returned.
         // `initial_map_with` certified `uv0`.
@@ -1408,6 +1498,7 @@ impl Parameterizer for SymmetricDirichlet {
                 },
             ),
         };
+        prof.newton_ms = clock.elapsed().as_secs_f64() * 1e3;
         let mut fell_back = log.fell_back;
         // Isometric in the mean: rescale so the 2D area equals the 3D area; a uniform scale
         // keeps orientations in exact arithmetic, and the certificate is re-checked.
@@ -1421,7 +1512,8 @@ impl Parameterizer for SymmetricDirichlet {
         report.iterations = log.iterations;
         report.hit_budget = log.hit_budget;
         report.fell_back = fell_back;
-        Ok(Parameterization { uv, report })
+        prof.newton = log;
+        Ok((Parameterization { uv, report }, prof))
     }
 }
 
@@ -1591,6 +1683,61 @@ mod tests {
             .map(|(p, q)| (p - q).norm())
             .fold(0.0, f64::max);
         assert!(err < 1e-9, "{err}");
+    }
+
+    #[test]
+    fn decrement_stop_skips_only_the_tail() {
+        // A spherical cap (not developable: the optimum keeps an excess E − 4 > 0) from its
+        // circle Tutte map.
+        let mut disk = crate::mesh::generators::disk(1.0, 12, 6);
+        for p in &mut disk.positions {
+            p.z = (4.0 - p.x * p.x - p.y * p.y).sqrt();
+        }
+        let boundary = super::super::disk_boundary(&disk).unwrap();
+        let (uv0, _) = certified_tutte(&disk, &boundary, TutteWeights::Cotan).unwrap();
+        let run = |decrement_tol: f64| {
+            let o = SdOptions {
+                decrement_tol,
+                ..Default::default()
+            };
+            newton(&disk, &boundary, &uv0, &o, true, &OnceCell::new()).unwrap()
+        };
+        let (uv_full, full) = run(0.0);
+        let (uv_tail, tail) = run(SdOptions::default().decrement_tol);
+        crate::invariants::certify_bijective(&uv_tail, &disk.triangles, &boundary).unwrap();
+        crate::invariants::certify_bijective(&uv_full, &disk.triangles, &boundary).unwrap();
+        // Same trajectory up to the stop, so never more iterations, and it stops early here.
+        assert!(
+            tail.iterations < full.iterations,
+            "{} {}",
+            tail.iterations,
+            full.iterations
+        );
+        assert_eq!(tail.energies[..], full.energies[..tail.energies.len()]);
+        // What it skips is below the predicted remainder (a few 1e-3 of the excess).
+        let (et, ef) = (
+            *tail.energies.last().unwrap(),
+            *full.energies.last().unwrap(),
+        );
+        assert!(!tail.hit_budget && !tail.fell_back);
+        assert!(et - ef <= 1e-2 * (et - 4.0), "{et} {ef}");
+    }
+
+    #[test]
+    fn triangle_slots_address_their_entries() {
+        let disk = crate::mesh::generators::disk(1.0, 5, 5);
+        let pat = Pattern::new(disk.n_vertices(), &disk.triangles);
+        for (t, slots) in disk.triangles.iter().zip(&pat.tri_slots) {
+            for l1 in 0..6 {
+                for l2 in 0..6 {
+                    let row = 2 * t[l1 / 2].idx() + l1 % 2;
+                    let col = 2 * t[l2 / 2].idx() + l2 % 2;
+                    let k = slots[l1 * 6 + l2] as usize;
+                    assert!(pat.col_ptr[col] <= k && k < pat.col_ptr[col + 1]);
+                    assert_eq!(pat.row_idx[k], row);
+                }
+            }
+        }
     }
 
     #[test]
