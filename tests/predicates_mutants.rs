@@ -385,3 +385,29 @@ fn shared_vertex_and_shared_edge_rules_match_cgal() {
         "faces_intersect rules vs CGAL's do_faces_intersect"
     );
 }
+
+/// A degenerate (collinear) triangle is the union of its three edges: a segment crossing one
+/// of those edges strictly between the corners meets it; one passing beside it does not.
+#[test]
+fn segment_meets_a_degenerate_triangle_along_its_edges() {
+    let p = |x: f64, y: f64, z: f64| Point3::new(x, y, z);
+    let t = [p(0.0, 0.0, 0.0), p(4.0, 0.0, 0.0), p(1.0, 0.0, 0.0)];
+    // Crosses the long edge at (2, 0, 0), which is no corner.
+    assert!(segment_triangle_intersect(
+        &p(2.0, -1.0, 0.0),
+        &p(2.0, 1.0, 0.0),
+        &t
+    ));
+    // Out of the line's plane at x = 2: passes above the edge.
+    assert!(!segment_triangle_intersect(
+        &p(2.0, -1.0, 1.0),
+        &p(2.0, 1.0, 1.0),
+        &t
+    ));
+    // Beyond the far corner.
+    assert!(!segment_triangle_intersect(
+        &p(5.0, -1.0, 0.0),
+        &p(5.0, 1.0, 0.0),
+        &t
+    ));
+}
