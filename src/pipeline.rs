@@ -389,7 +389,7 @@ pub fn remesh(
     field: &MetricField,
     stages: &Stages,
     options: &RemeshOptions,
-    on_progress: impl FnMut(Progress),
+    mut on_progress: impl FnMut(Progress),
 ) -> Result<RemeshResult, PipelineError> {
     let reference = field.reference();
     if reference.n_faces() == 0 {
@@ -429,27 +429,6 @@ pub fn remesh(
     } else {
         Vec::new()
     };
-    remesh_core(
-        field,
-        stages,
-        options,
-        (l_avg, l_tar, min_edge),
-        fid_scale,
-        on_progress,
-    )
-}
-
-/// Algorithm 1 proper on `field`'s reference, with the fidelity scale precomputed.
-fn remesh_core(
-    field: &MetricField,
-    stages: &Stages,
-    options: &RemeshOptions,
-    (l_avg, l_tar, min_edge): (f64, f64, f64),
-    fid_scale: Vec<f64>,
-    mut on_progress: impl FnMut(Progress),
-) -> Result<RemeshResult, PipelineError> {
-    let reference = field.reference();
-    let eps = options.fidelity.max_deviation;
     let scaled_field;
     // The metric every quality measure uses (the unscaled one).
     let quality_field = field;
