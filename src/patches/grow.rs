@@ -18,6 +18,10 @@
 //! (two faces, consistently oriented: [`Topology::neighbor`]) and not feature edges; mesh
 //! boundary edges have a single face and are never shared, so patches never cross them.
 //! `certify_disk` re-checks every produced patch.
+//!
+//! **Corners.** A face that would close the fan of a [`PatchContext::corners`] vertex (the
+//! `k = 2` case at that vertex, or the last face around it) is refused
+//! ([`Refusal::Corner`]), so such vertices never become interior to a patch.
 
 use super::cone_fit::cone_error;
 use super::growth_cost::{growth_cost, ConeOptions};
