@@ -44,5 +44,5 @@ pub enum Error {
     Report(#[from] crate::report::ReportError),
 }
 
-/// Result with the crate's [`Error`].
+/// Result with the crate's [`enum@Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;

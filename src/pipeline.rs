@@ -160,13 +160,13 @@ pub struct RemeshOptions {
     /// screwdriver's blade tip is cut again (Hausdorff 0.78 % → 1.83 % of the diagonal).
     pub corner_pullback: bool,
     /// After the loop, flip edges whose flip raises the smaller metric quality of their two
-    /// faces (our addition; see [`flip_pass`]). Every flip is certified like a patch's new
+    /// faces (our addition; see `flip_pass`). Every flip is certified like a patch's new
     /// faces (not degenerate, not flipped, locally embedded) and keeps the surface within
     /// the fidelity tolerance. Default `true`.
     pub edge_flips: bool,
     /// After the flips, move vertices towards their neighbours' centroid on the reference
     /// surface where the worst face around them improves, then flip again (our addition;
-    /// see [`smooth_pass`]). Default `true`.
+    /// see `smooth_pass`). Default `true`.
     pub relocate: bool,
     /// Input vertices whose angle defect `|2π − Σθ|` is at least this many radians are kept
     /// as vertices of the output (our addition, see [`crate::patches::corner_vertices`]): no

@@ -302,7 +302,7 @@ pub fn segment_triangle_intersect(a: &Point3<f64>, b: &Point3<f64>, t: &[Point3<
 /// Möller's plane-side rejection first (three `orient3d` per plane); then the triangles
 /// meet iff an edge of one meets the other: the intersection of two convex polygons, if not
 /// empty, has an extreme point on the boundary of one of them. Every decision is an exact
-/// `orient3d`, or an exact `orient2d` on a projection chosen by [`projection_axis`].
+/// `orient3d`, or an exact `orient2d` on a projection chosen by `projection_axis`.
 pub fn triangles_intersect(a: &[Point3<f64>; 3], b: &[Point3<f64>; 3]) -> bool {
     let pa = projection_axis(&a[0], &a[1], &a[2]);
     let pb = projection_axis(&b[0], &b[1], &b[2]);

@@ -1,4 +1,4 @@
-//! Bijective low-distortion parameterization of a disk patch (Sec. 3.3, ref. [30]) and the
+//! Bijective low-distortion parameterization of a disk patch (Sec. 3.3, ref. \[30\]) and the
 //! [`Parameterizer`] extension point.
 
 mod distortion;

@@ -52,7 +52,7 @@ pub struct SdOptions {
     /// optimisation from there needs many more iterations and can end in a worse local
     /// minimum with the boundary pressed against itself.
     pub free_boundary_init: bool,
-    /// Newton iteration budget [100]; running out is reported (`hit_budget`), not an error.
+    /// Newton iteration budget \[100\]; running out is reported (`hit_budget`), not an error.
     pub max_iters: usize,
     /// Stop when a step decreases the energy excess `E − 4` over an isometry by less than
     /// this fraction [1e-4].
@@ -87,10 +87,10 @@ pub struct SdOptions {
     /// penetrating boundary vertex `repair_margin` back out of the edge it crossed (no
     /// barrier, no certificate during the steps; stops early once certified, or when the
     /// number of crossing boundary edges has not fallen for 6 steps). The result is used
-    /// only if it passes the exact certificate, else the Tutte map [30]; 0 disables.
+    /// only if it passes the exact certificate, else the Tutte map \[30\]; 0 disables.
     pub repair_iters: usize,
     /// Weight of one overlap-repair term relative to one average triangle's energy share
-    /// (0: plain locally injective steps) [100].
+    /// (0: plain locally injective steps) \[100\].
     pub repair_weight: f64,
     /// Clearance the overlap repair aims for, as a fraction of the mean 3D edge length [0.2].
     pub repair_margin: f64,
@@ -98,9 +98,9 @@ pub struct SdOptions {
     /// of the wanted step, re-solve with the colliding vertices stiffened along the edge
     /// normal [0: measured slower, see paper-notes]; 0 disables.
     pub collision_active_below: f64,
-    /// Re-solves per iteration for the active set [2].
+    /// Re-solves per iteration for the active set \[2\].
     pub collision_rounds: usize,
-    /// Stiffness of an active pair relative to the mean Hessian diagonal [1e3].
+    /// Stiffness of an active pair relative to the mean Hessian diagonal \[1e3\].
     pub collision_stiffness: f64,
     /// Also stop, before the line search, when the Newton decrement `−∇E·d` of the current
     /// direction `d` (twice the decrease the quadratic model predicts for the full step) is

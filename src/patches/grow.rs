@@ -15,7 +15,7 @@
 //!   (the paper's test would accept it).
 //!
 //! Shared edges become interior edges of the patch, so they must be manifold mesh edges
-//! (two faces, consistently oriented: [`Topology::neighbor`]) and not feature edges; mesh
+//! (two faces, consistently oriented: [`crate::mesh::Topology::neighbor`]) and not feature edges; mesh
 //! boundary edges have a single face and are never shared, so patches never cross them.
 //! `certify_disk` re-checks every produced patch.
 //!
