@@ -96,8 +96,22 @@ fn main() {
         res.report.patches,
         si_faces.len()
     );
+    // Output vertices at an input corner (`RemeshOptions::corner_defect`): exact positions.
+    let corner_pos: std::collections::HashSet<[u64; 3]> = {
+        let topo = conemesh::Topology::build(&unit);
+        let c = conemesh::patches::corner_vertices(&unit, &topo, 1.0);
+        (0..unit.n_vertices())
+            .filter(|&v| c[v])
+            .map(|v| unit.positions[v].coords.map(f64::to_bits).into())
+            .collect()
+    };
+    let at_corner = |v: conemesh::VertexId| {
+        let b: [u64; 3] = out.positions[v.idx()].coords.map(f64::to_bits).into();
+        corner_pos.contains(&b)
+    };
     let classes = [
         "kept",
+        "corner fan",
         "near SI",
         "seam edge",
         "seam vertex",
@@ -114,16 +128,18 @@ fn main() {
             .unwrap_or(false);
         let class = if res.face_patch[f].is_none() {
             0
-        } else if near_si {
+        } else if t.iter().any(|v| at_corner(*v)) {
             1
-        } else if on_seam[f] {
+        } else if near_si {
             2
-        } else if t.iter().any(|v| seam_vertex[v.idx()]) {
+        } else if on_seam[f] {
             3
-        } else if res.face_patch[f].map(|p| retried[p.idx()]).unwrap_or(false) {
+        } else if t.iter().any(|v| seam_vertex[v.idx()]) {
             4
-        } else {
+        } else if res.face_patch[f].map(|p| retried[p.idx()]).unwrap_or(false) {
             5
+        } else {
+            6
         };
         let s = &mut stats[class];
         s.0 += 1;
