@@ -89,4 +89,32 @@ proptest! {
         let b = run(seed);
         prop_assert_eq!(a, b);
     }
+
+    /// With random vertices marked as corners, no patch of a covering run (cone or k-ring)
+    /// contains a corner in its interior, and the run still covers every face.
+    #[test]
+    fn cover_runs_keep_corners_on_patch_boundaries(kind in 0u8..5, seed in 0u64..1000, kring in any::<bool>()) {
+        let m = surface(kind, seed);
+        let topo = Topology::build(&m);
+        let mut rng = conemesh::Rng::seed_from_u64(seed);
+        let corners: Vec<bool> = (0..m.n_vertices()).map(|_| rng.random_bool(0.2)).collect();
+        let cone = ConePatches::default();
+        let kr = KRingDisks::default();
+        let s: &dyn PatchStrategy = if kring { &kr } else { &cone };
+        let opts = CoverOptions { corners: Some(corners.clone()), ..Default::default() };
+        let run = cover(&m, s, &opts, &mut rng).expect("cover");
+        prop_assert!(run.complete);
+        for p in &run.patches {
+            let mut count = std::collections::HashMap::new();
+            for f in &p.faces {
+                for v in m.face(*f) {
+                    *count.entry(v).or_insert(0usize) += 1;
+                }
+            }
+            for (v, n) in count {
+                let interior = !topo.is_boundary_vertex(v) && n == topo.vertex_faces(v).len();
+                prop_assert!(!(corners[v.idx()] && interior), "corner {} inside a patch", v);
+            }
+        }
+    }
 }
