@@ -26,6 +26,16 @@ use std::collections::HashSet;
 pub fn non_manifold_vertices(mesh: &TriMesh, topo: &Topology) -> Vec<VertexId> {
     let mut out = Vec::new();
     let tris = |f: FaceId| mesh.face(f);
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    // Buffers reused across vertices (this runs after every patch of Algorithm 1).
+    let mut parent: Vec<usize> = Vec::new();
+    let mut spokes: Vec<(VertexId, usize)> = Vec::new();
     for v in 0..topo.n_vertices() {
         let v = VertexId::new(v);
         let faces = topo.vertex_faces(v);
@@ -34,15 +44,9 @@ pub fn non_manifold_vertices(mesh: &TriMesh, topo: &Topology) -> Vec<VertexId> {
         }
         // Each face at v has two edges at v, named by their other endpoint; faces sharing an
         // other endpoint share that edge. Union–find over the (small) fan.
-        let mut parent: Vec<usize> = (0..faces.len()).collect();
-        fn find(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
-        let mut spokes: Vec<(VertexId, usize)> = Vec::with_capacity(2 * faces.len());
+        parent.clear();
+        parent.extend(0..faces.len());
+        spokes.clear();
         for (k, &f) in faces.iter().enumerate() {
             for w in tris(f) {
                 if w != v {
