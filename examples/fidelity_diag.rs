@@ -25,14 +25,20 @@ fn main() {
     let pc2 = principal_curvatures(&ui, &CurvatureOptions { radius: 2 }).expect("pc");
     let pi = SurfaceProjector::new(&ui);
     let po = SurfaceProjector::new(&uo);
-    // Dense samples: vertices + 20 points per face, deterministic.
+    // Dense samples, deterministic: a regular grid of N = $DIAG_N (default 5) steps per face
+    // side, edges included (the largest distances of a piecewise-flat input sit on its
+    // creases, i.e. on face edges).
+    let n: usize = std::env::var("DIAG_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(5);
     let samples = |m: &TriMesh| -> Vec<Point3<f64>> {
         let mut v = m.positions.clone();
         for f in m.faces() {
             let [p, q, r] = m.face_points(f);
-            for i in 1..5 {
-                for j in 1..(5 - i) {
-                    let (u, w) = (i as f64 / 5.0, j as f64 / 5.0);
+            for i in 0..=n {
+                for j in 0..=(n - i) {
+                    let (u, w) = (i as f64 / n as f64, j as f64 / n as f64);
                     v.push(Point3::from(
                         p.coords * (1.0 - u - w) + q.coords * u + r.coords * w,
                     ));

@@ -16,6 +16,9 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Benchmark `remesh` on a folder of meshes (the shared meshes): quality, Hausdorff
+    /// distance, time and peak memory per mesh, as a Markdown table.
+    Bench(cli::bench::BenchArgs),
     /// Check a mesh: topology, manifoldness, degenerate faces, self-intersections.
     Check(cli::check::CheckArgs),
     /// Convert a mesh between formats (by file extension).
@@ -33,6 +36,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Bench(a) => cli::bench::run(a),
         Command::Check(a) => cli::check::run(a),
         Command::Convert(a) => cli::convert::run(a),
         Command::Eval(a) => cli::eval::run(a),

@@ -1,5 +1,6 @@
 //! One file per subcommand: `XArgs` (clap) and `run(XArgs) -> anyhow::Result<ExitCode>`.
 
+pub mod bench;
 pub mod check;
 pub mod convert;
 pub mod eval;

@@ -253,6 +253,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             "input": name,
             "output": args.output,
             "seconds": elapsed,
+            "peak_rss_mb": peak_rss_mb(),
             "run": result.report,
             "eval": eval,
         });
@@ -271,6 +272,15 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("writing plots into {}", dir.display()))?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// This process's peak resident memory in MB (`VmHWM` of `/proc/self/status`; `None` where
+/// there is no such file, i.e. off Linux).
+fn peak_rss_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
 }
 
 fn strategy(name: &str) -> anyhow::Result<Box<dyn conemesh::patches::PatchStrategy>> {

@@ -1,0 +1,278 @@
+//! `conemesh bench`: the end-to-end benchmark. Runs `conemesh remesh` on every mesh of a
+//! folder (the shared meshes by default), one child process at a time, and writes the table
+//! the issues ask for: faces, Table-1 quality, Hausdorff distance, flips, wall time and peak
+//! memory per mesh, and whether the Algorithm-1 targets are met.
+//!
+//! Each mesh runs in its own process so that its peak resident memory is its own (the child
+//! reports `VmHWM` in its JSON report) and a failing mesh cannot take the others down.
+
+use anyhow::{bail, Context};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+use std::time::Instant;
+
+/// The extensions `conemesh` reads (see `conemesh::io`).
+const MESH_EXTENSIONS: [&str; 5] = ["obj", "off", "ply", "stl", "mesh"];
+
+/// Arguments of `conemesh bench`.
+#[derive(clap::Args, Debug)]
+pub struct BenchArgs {
+    /// Meshes to run; without any, every mesh file in `--dir`, by name.
+    pub meshes: Vec<PathBuf>,
+    /// Folder whose meshes run when none are named.
+    #[arg(long, default_value = "../shared/meshes")]
+    pub dir: PathBuf,
+    /// Folder for the outputs: `remesh.md` (the table), and per mesh `NAME.obj`, `NAME.json`
+    /// (the remesh report) and `NAME.log` (its stdout and stderr).
+    #[arg(short, long, default_value = "bench")]
+    pub out_dir: PathBuf,
+    /// Further arguments for every `conemesh remesh` run, after `--`
+    /// (e.g. `conemesh bench -- --sweeps 2 --seed 3`).
+    #[arg(last = true)]
+    pub remesh_args: Vec<String>,
+}
+
+/// The targets of Algorithm 1 before minimum-angle improvement (issue 9, the paper's Table 1
+/// level), measured by `eval` against the input at the run's L_tar.
+const TARGET_Q_AVG: f64 = 0.85;
+const TARGET_THETA_AVG: f64 = 47.0;
+const TARGET_HAUSDORFF_REL: f64 = 0.01;
+
+/// One benchmark row.
+struct Row {
+    name: String,
+    outcome: Result<Numbers, String>,
+    wall: f64,
+}
+
+struct Numbers {
+    faces_in: u64,
+    faces_out: u64,
+    patches: u64,
+    q_min: f64,
+    q_avg: f64,
+    theta_min: f64,
+    theta_avg: f64,
+    hausdorff_rel: f64,
+    flips: usize,
+    seconds: f64,
+    peak_mb: Option<f64>,
+}
+
+impl Numbers {
+    /// The targets this run misses, by name.
+    fn missed(&self) -> Vec<&'static str> {
+        let mut m = Vec::new();
+        if self.q_avg < TARGET_Q_AVG {
+            m.push("q_avg");
+        }
+        if self.theta_avg < TARGET_THETA_AVG {
+            m.push("θ_avg");
+        }
+        if self.flips > 0 {
+            m.push("flips");
+        }
+        if self.hausdorff_rel > TARGET_HAUSDORFF_REL {
+            m.push("Hausdorff");
+        }
+        m
+    }
+
+    /// The numbers of a `conemesh remesh --report` file.
+    fn from_report(json: &serde_json::Value) -> Result<Numbers, String> {
+        let get = |path: &[&str]| -> Result<&serde_json::Value, String> {
+            path.iter()
+                .try_fold(json, |v, k| v.get(k))
+                .ok_or_else(|| format!("the report has no `{}`", path.join(".")))
+        };
+        let f = |path: &[&str]| -> Result<f64, String> {
+            get(path)?
+                .as_f64()
+                .ok_or_else(|| format!("`{}` is not a number", path.join(".")))
+        };
+        let u = |path: &[&str]| -> Result<u64, String> {
+            get(path)?
+                .as_u64()
+                .ok_or_else(|| format!("`{}` is not a count", path.join(".")))
+        };
+        Ok(Numbers {
+            faces_in: u(&["run", "faces_in"])?,
+            faces_out: u(&["run", "faces_out"])?,
+            patches: u(&["run", "patches"])?,
+            q_min: f(&["eval", "output_quality", "q_min"])?,
+            q_avg: f(&["eval", "output_quality", "q_avg"])?,
+            theta_min: f(&["eval", "output_quality", "theta_min"])?,
+            theta_avg: f(&["eval", "output_quality", "theta_avg"])?,
+            hausdorff_rel: f(&["eval", "distance", "hausdorff_rel"])?,
+            flips: get(&["eval", "flips"])?
+                .as_array()
+                .map(|a| a.len())
+                .ok_or("`eval.flips` is not a list")?,
+            seconds: f(&["seconds"])?,
+            peak_mb: json.get("peak_rss_mb").and_then(|v| v.as_f64()),
+        })
+    }
+}
+
+/// Run `conemesh bench`.
+pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
+    let meshes = if args.meshes.is_empty() {
+        meshes_in(&args.dir)?
+    } else {
+        args.meshes.clone()
+    };
+    if meshes.is_empty() {
+        bail!("no mesh files in {}", args.dir.display());
+    }
+    std::fs::create_dir_all(&args.out_dir)
+        .with_context(|| format!("creating {}", args.out_dir.display()))?;
+    let exe = std::env::current_exe().context("locating the conemesh executable")?;
+    let mut rows = Vec::new();
+    for mesh in &meshes {
+        let name = mesh
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| mesh.display().to_string());
+        let out = args.out_dir.join(format!("{name}.obj"));
+        let report = args.out_dir.join(format!("{name}.json"));
+        // A stale report must not be read as this run's.
+        let _ = std::fs::remove_file(&report);
+        let t0 = Instant::now();
+        let child = Command::new(&exe)
+            .arg("remesh")
+            .arg(mesh)
+            .arg("-o")
+            .arg(&out)
+            .arg("--report")
+            .arg(&report)
+            .arg("--quiet")
+            .args(&args.remesh_args)
+            .output()
+            .with_context(|| format!("running {} remesh", exe.display()))?;
+        let wall = t0.elapsed().as_secs_f64();
+        let mut log = child.stdout.clone();
+        log.extend_from_slice(&child.stderr);
+        let log_path = args.out_dir.join(format!("{name}.log"));
+        conemesh::io::write_bytes_atomic(&log_path, &log)
+            .with_context(|| format!("writing {}", log_path.display()))?;
+        let outcome = if child.status.success() {
+            std::fs::read_to_string(&report)
+                .map_err(|e| format!("reading {}: {e}", report.display()))
+                .and_then(|s| {
+                    serde_json::from_str::<serde_json::Value>(&s)
+                        .map_err(|e| format!("{}: {e}", report.display()))
+                })
+                .and_then(|j| Numbers::from_report(&j))
+        } else {
+            let stderr = String::from_utf8_lossy(&child.stderr);
+            let last = stderr.lines().rev().find(|l| !l.trim().is_empty());
+            Err(format!(
+                "remesh failed ({}): {}",
+                child.status,
+                last.unwrap_or("no message")
+            ))
+        };
+        let row = Row {
+            name,
+            outcome,
+            wall,
+        };
+        eprintln!("{}", row_text(&row));
+        rows.push(row);
+    }
+    let table = table(&rows, &args.remesh_args);
+    print!("{table}");
+    let path = args.out_dir.join("remesh.md");
+    conemesh::io::write_bytes_atomic(&path, table.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {}", path.display());
+    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
+    if failed > 0 {
+        eprintln!("error: {failed} of {} runs failed", rows.len());
+        return Ok(ExitCode::from(1));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The mesh files of `dir`, sorted by file name.
+fn meshes_in(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry
+            .with_context(|| format!("reading {}", dir.display()))?
+            .path();
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        if path.is_file() && ext.is_some_and(|e| MESH_EXTENSIONS.contains(&e.as_str())) {
+            out.push(path);
+        }
+    }
+    out.sort_by(|a, b| a.file_name().cmp(&b.file_name()));
+    Ok(out)
+}
+
+fn row_text(r: &Row) -> String {
+    match &r.outcome {
+        Ok(n) => {
+            let missed = n.missed();
+            format!(
+                "| {} | {} | {} | {:.3} / {:.3} | {:.2} / {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {} | {} |",
+                r.name,
+                n.faces_in,
+                n.faces_out,
+                n.q_min,
+                n.q_avg,
+                n.theta_min,
+                n.theta_avg,
+                100.0 * n.hausdorff_rel,
+                n.flips,
+                n.patches,
+                n.seconds,
+                r.wall,
+                n.peak_mb.map_or("-".into(), |m| format!("{m:.0}")),
+                if missed.is_empty() {
+                    "met".to_string()
+                } else {
+                    format!("missed: {}", missed.join(", "))
+                }
+            )
+        }
+        Err(e) => format!(
+            "| {} | - | - | - | - | - | - | - | - | {:.2} | - | FAILED: {} |",
+            r.name,
+            r.wall,
+            e.replace('|', "/")
+        ),
+    }
+}
+
+fn table(rows: &[Row], remesh_args: &[String]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# conemesh bench: `conemesh remesh MESH{}{}`, one process per mesh\n",
+        if remesh_args.is_empty() { "" } else { " " },
+        remesh_args.join(" ")
+    );
+    let _ = writeln!(
+        s,
+        "Quality and distance from `eval` of the written output against its input (metric space, \
+         L_tar of the run); Hausdorff in % of the input's bounding-box diagonal; `remesh s` is the \
+         run's own time (reading, metric, Algorithm 1 with its certificates), `wall s` the whole \
+         process's (also `eval` and writing); \
+         peak MB is the process's peak resident memory (VmHWM). Targets (issue 9): q_avg ≥ {TARGET_Q_AVG}, \
+         θ_avg ≥ {TARGET_THETA_AVG}°, 0 flips, Hausdorff ≤ {} %.\n",
+        100.0 * TARGET_HAUSDORFF_REL
+    );
+    let _ = writeln!(
+        s,
+        "| mesh | F in | F out | q_min / q_avg | θ_min / θ_avg (°) | Hausdorff % | flips | patches | remesh s | wall s | peak MB | targets |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in rows {
+        let _ = writeln!(s, "{}", row_text(r));
+    }
+    s
+}
