@@ -28,7 +28,7 @@ fn main() {
     // Dense samples, deterministic: a regular grid of N = $DIAG_N (default 5) steps per face
     // side, edges included (the largest distances of a piecewise-flat input sit on its
     // creases, i.e. on face edges).
-    let n: usize = std::env::var("DIAG_N")
+    let steps: usize = std::env::var("DIAG_N")
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(5);
@@ -36,9 +36,9 @@ fn main() {
         let mut v = m.positions.clone();
         for f in m.faces() {
             let [p, q, r] = m.face_points(f);
-            for i in 0..=n {
-                for j in 0..=(n - i) {
-                    let (u, w) = (i as f64 / n as f64, j as f64 / n as f64);
+            for i in 0..=steps {
+                for j in 0..=(steps - i) {
+                    let (u, w) = (i as f64 / steps as f64, j as f64 / steps as f64);
                     v.push(Point3::from(
                         p.coords * (1.0 - u - w) + q.coords * u + r.coords * w,
                     ));
