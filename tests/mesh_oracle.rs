@@ -8,8 +8,8 @@
 //! with `src/mesh/topology.rs` or `src/invariants/mesh.rs`.
 
 use conemesh::invariants::{
-    certify_manifold, certify_oriented, certify_same_topology, non_manifold_vertices,
-    InvariantError,
+    certify_manifold, certify_manifold_at, certify_oriented, certify_same_topology,
+    non_manifold_vertices, InvariantError, Offenders,
 };
 use conemesh::mesh::generators;
 use conemesh::{EdgeKey, FaceId, HalfedgeId, Rng, Topology, TriMesh, VertexId};
@@ -463,6 +463,30 @@ fn certificates_agree_with_the_oracle_on_soups() {
             ));
         } else {
             assert_eq!(manifold, Ok(()));
+        }
+        // The local certificate over every vertex is the whole one; over a random subset
+        // it reports exactly the subset's pinch vertices.
+        let all: Vec<VertexId> = (0..m.n_vertices()).map(VertexId::new).collect();
+        assert_eq!(certify_manifold_at(&m, &t, &all), manifold, "soup {case}");
+        let some: Vec<VertexId> = all
+            .iter()
+            .copied()
+            .filter(|_| rng.random_bool(0.5))
+            .collect();
+        let expect: Vec<VertexId> = non_manifold_vertices(&m, &t)
+            .into_iter()
+            .filter(|v| some.contains(v))
+            .collect();
+        match certify_manifold_at(&m, &t, &some) {
+            Err(InvariantError::NonManifoldEdges(_)) => {
+                assert!(!t.non_manifold_edges().is_empty())
+            }
+            Err(InvariantError::NonManifoldVertices(Offenders(v))) => {
+                assert!(t.non_manifold_edges().is_empty());
+                assert_eq!(v, expect, "soup {case}")
+            }
+            Ok(()) => assert!(t.non_manifold_edges().is_empty() && expect.is_empty()),
+            Err(e) => panic!("soup {case}: unexpected {e}"),
         }
         assert_eq!(
             certify_oriented(&m, &t).is_ok(),

@@ -24,6 +24,16 @@ use std::collections::HashSet;
 /// reported once, as what it is, and does not also turn its vertices into pinch points.
 /// Sorted.
 pub fn non_manifold_vertices(mesh: &TriMesh, topo: &Topology) -> Vec<VertexId> {
+    non_manifold_vertices_among(mesh, topo, (0..topo.n_vertices()).map(VertexId::new))
+}
+
+/// [`non_manifold_vertices`] restricted to `vertices` (in their order), for a mesh that
+/// changed only around them.
+pub fn non_manifold_vertices_among(
+    mesh: &TriMesh,
+    topo: &Topology,
+    vertices: impl IntoIterator<Item = VertexId>,
+) -> Vec<VertexId> {
     let mut out = Vec::new();
     let tris = |f: FaceId| mesh.face(f);
     fn find(p: &mut [usize], mut x: usize) -> usize {
@@ -36,8 +46,7 @@ pub fn non_manifold_vertices(mesh: &TriMesh, topo: &Topology) -> Vec<VertexId> {
     // Buffers reused across vertices (this runs after every patch of Algorithm 1).
     let mut parent: Vec<usize> = Vec::new();
     let mut spokes: Vec<(VertexId, usize)> = Vec::new();
-    for v in 0..topo.n_vertices() {
-        let v = VertexId::new(v);
+    for v in vertices {
         let faces = topo.vertex_faces(v);
         if faces.len() <= 1 {
             continue;
@@ -80,6 +89,41 @@ pub fn certify_manifold(mesh: &TriMesh, topo: &Topology) -> Result<(), Invariant
         )));
     }
     let verts = non_manifold_vertices(mesh, topo);
+    if !verts.is_empty() {
+        return Err(InvariantError::NonManifoldVertices(Offenders(verts)));
+    }
+    Ok(())
+}
+
+/// [`certify_manifold`] for a mesh that was manifold and then changed only in faces around
+/// `touched` (the vertices of the faces removed and added): every edge still has one or two
+/// faces (checked everywhere; the topology lists them), and every touched vertex's faces form
+/// one fan. A vertex not touched has the same faces as before, so this certifies the whole
+/// mesh by induction — Algorithm 1 certifies the input with [`certify_manifold`] and every
+/// patch replacement with this, at the cost of the patch instead of the mesh. Offending
+/// vertices are reported sorted.
+pub fn certify_manifold_at(
+    mesh: &TriMesh,
+    topo: &Topology,
+    touched: &[VertexId],
+) -> Result<(), InvariantError> {
+    debug_assert_eq!(mesh.n_faces(), topo.n_faces());
+    let edges = topo.non_manifold_edges();
+    if !edges.is_empty() {
+        return Err(InvariantError::NonManifoldEdges(Offenders(
+            edges.iter().map(|&(e, k)| EdgeFaces(e, k)).collect(),
+        )));
+    }
+    let mut verts = non_manifold_vertices_among(
+        mesh,
+        topo,
+        touched
+            .iter()
+            .copied()
+            .filter(|v| v.idx() < topo.n_vertices()),
+    );
+    verts.sort_unstable();
+    verts.dedup();
     if !verts.is_empty() {
         return Err(InvariantError::NonManifoldVertices(Offenders(verts)));
     }
@@ -447,6 +491,57 @@ mod tests {
             InvariantError::InconsistentOrientation(Offenders(vec![EdgeKey(
                 VertexId(0),
                 VertexId(1)
+            )]))
+        );
+    }
+
+    /// The local certificate checks the vertices it is given (in any order, with repeats and
+    /// out-of-range ids ignored) and every edge; it agrees with the whole-mesh certificate
+    /// whenever the offending vertex is among them.
+    #[test]
+    fn local_manifold_certificate_checks_the_touched_vertices_and_every_edge() {
+        let p = [
+            (0., 0., 0.),
+            (1., 0., 0.),
+            (0.5, 1., 0.),
+            (0.5, -1., 0.),
+            (0.5, 0., 1.),
+            (-1., 0.5, 0.),
+            (-1., -0.5, 0.),
+            (-1., -0.5, 1.),
+        ];
+        // Two fans pinched at v0, and a second pinch at v5 (faces 1 and 2 meet only there).
+        let m = mesh(&p, &[[0, 1, 2], [0, 5, 6], [5, 3, 7]]);
+        let t = Topology::build(&m);
+        let whole = certify_manifold(&m, &t).unwrap_err();
+        assert_eq!(
+            whole,
+            InvariantError::NonManifoldVertices(Offenders(vec![VertexId(0), VertexId(5)]))
+        );
+        let at = |vs: &[u32]| {
+            let vs: Vec<VertexId> = vs.iter().map(|&v| VertexId(v)).collect();
+            certify_manifold_at(&m, &t, &vs)
+        };
+        assert_eq!(at(&[5, 0, 5, 99]).unwrap_err(), whole);
+        assert_eq!(
+            at(&[2, 5]).unwrap_err(),
+            InvariantError::NonManifoldVertices(Offenders(vec![VertexId(5)]))
+        );
+        // Untouched pinches are the caller's induction hypothesis, not checked.
+        at(&[1, 2, 6]).unwrap();
+        at(&[]).unwrap();
+        assert_eq!(
+            non_manifold_vertices_among(&m, &t, [VertexId(5), VertexId(0)]),
+            vec![VertexId(5), VertexId(0)]
+        );
+        // A non-manifold edge is found whatever the touched vertices.
+        let m = mesh(&p, &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]);
+        let t = Topology::build(&m);
+        assert_eq!(
+            certify_manifold_at(&m, &t, &[]).unwrap_err(),
+            InvariantError::NonManifoldEdges(Offenders(vec![EdgeFaces(
+                EdgeKey(VertexId(0), VertexId(1)),
+                3
             )]))
         );
     }

@@ -56,7 +56,9 @@ pub struct Topology {
     boundary_loop_component: Vec<u32>,
     non_manifold_edges: Vec<(EdgeKey, usize)>,
     inconsistent_edges: Vec<EdgeKey>,
-    non_manifold_vertices: Vec<VertexId>,
+    /// Computed on first use: Algorithm 1 rebuilds the topology after every patch and
+    /// certifies the vertices it touched itself (`invariants::non_manifold_vertices_among`).
+    non_manifold_vertices: std::sync::OnceLock<Vec<VertexId>>,
 }
 
 fn find(parent: &mut [u32], mut x: u32) -> u32 {
@@ -197,9 +199,8 @@ impl Topology {
             boundary_loop_component: Vec::new(),
             non_manifold_edges,
             inconsistent_edges,
-            non_manifold_vertices: Vec::new(),
+            non_manifold_vertices: std::sync::OnceLock::new(),
         };
-        topo.non_manifold_vertices = topo.find_non_manifold_vertices();
         topo.boundary_loops = topo.trace_boundary_loops();
         topo.boundary_loop_component = topo
             .boundary_loops
@@ -471,7 +472,8 @@ impl Topology {
 
     /// Vertices whose faces form more than one fan (pinch points), sorted.
     pub fn non_manifold_vertices(&self) -> &[VertexId] {
-        &self.non_manifold_vertices
+        self.non_manifold_vertices
+            .get_or_init(|| self.find_non_manifold_vertices())
     }
 
     /// True when every edge has one or two faces, every vertex one fan, and orientation is
@@ -479,7 +481,7 @@ impl Topology {
     pub fn is_oriented_manifold(&self) -> bool {
         self.non_manifold_edges.is_empty()
             && self.inconsistent_edges.is_empty()
-            && self.non_manifold_vertices.is_empty()
+            && self.non_manifold_vertices().is_empty()
     }
 }
 
