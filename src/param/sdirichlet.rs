@@ -113,6 +113,20 @@ pub struct SdOptions {
     /// default: the total parameterization time fell only 2 %, and the slightly different
     /// maps moved the remeshed outputs (screwdriver's Hausdorff 0.77 → 1.04 % of the diagonal).
     pub decrement_tol: f64,
+    /// Adaptive boundary barrier (IPC-style, Li et al. 2020), weight of one term relative
+    /// to one average triangle's energy share [0 = off]. When the collision bound cuts a
+    /// step, every boundary (vertex, edge) pair it found enters the objective with the
+    /// smooth (C²) log barrier `−(x − 1)² ln x`, `x = d / d̂` on the triangle-inequality gap
+    /// `d`, activated at the pair's current gap (`d̂ = d`, so the objective does not jump);
+    /// the next Newton model then sees the pair instead of driving it shut again.
+    pub adaptive_barrier: f64,
+    /// The overlap repair stops once the map is certified with every repaired vertex at
+    /// least this fraction of `repair_margin` outside the edge it crossed \[0.5\].
+    pub repair_clearance: f64,
+    /// After every accepted step each adaptive pair's activation gap shrinks to at most
+    /// this multiple of its current gap, `d̂ ← min(d̂, γ d)` \[2\] (never grows, so the
+    /// objective never increases); pairs with `d̂` below the fixed barrier's `ε` are dropped.
+    pub adaptive_shrink: f64,
 }
 
 impl Default for SdOptions {
@@ -136,6 +150,9 @@ impl Default for SdOptions {
             collision_rounds: 2,
             collision_stiffness: 1e3,
             decrement_tol: 0.0,
+            adaptive_barrier: 0.0,
+            repair_clearance: 0.5,
+            adaptive_shrink: 2.0,
         }
     }
 }
@@ -588,6 +605,51 @@ struct Problem<'a> {
     pen_w: f64,
     pen_margin: f64,
     pen_pairs: Vec<[usize; 3]>,
+    /// Adaptive barrier (`SdOptions::adaptive_barrier`): weight of one term, and the
+    /// (vertex, edge start, edge end) pairs with their activation gap `d̂`.
+    adapt_w: f64,
+    adaptive: Vec<([usize; 3], f64)>,
+}
+
+/// Triangle-inequality gap `|p − a| + |p − b| − |a − b|` of vertex `p` and edge `ab`
+/// (vertex indices), zero exactly when `p` lies on the segment.
+fn tri_gap(uv: &[Point2<f64>], p: usize, a: usize, b: usize) -> f64 {
+    (uv[p] - uv[a]).norm() + (uv[p] - uv[b]).norm() - (uv[a] - uv[b]).norm()
+}
+
+/// Gradient of [`tri_gap`] with respect to `p`, `a` and `b`.
+fn tri_gap_grad(uv: &[Point2<f64>], p: usize, a: usize, b: usize) -> [(usize, Vector2<f64>); 3] {
+    let unit = |x: Point2<f64>, y: Point2<f64>| {
+        let v = x - y;
+        let l = v.norm();
+        if l > 0.0 {
+            v / l
+        } else {
+            Vector2::zeros()
+        }
+    };
+    let (pp, pa, pb) = (uv[p], uv[a], uv[b]);
+    [
+        (p, unit(pp, pa) + unit(pp, pb)),
+        (a, unit(pa, pp) - unit(pa, pb)),
+        (b, unit(pb, pp) - unit(pb, pa)),
+    ]
+}
+
+/// The C² log barrier of IPC (Li et al. 2020) in the normalised gap `x = d / d̂`:
+/// `b(x) = −(x − 1)² ln x` on `(0, 1)`, 0 from 1 on; value, first and second derivative.
+/// `b`, `b'` and `b''` vanish at `x = 1`, so activating a pair at its current gap changes
+/// neither the objective nor its gradient.
+fn ipc_barrier(x: f64) -> (f64, f64, f64) {
+    if x >= 1.0 {
+        return (0.0, 0.0, 0.0);
+    }
+    let (l, y) = (x.ln(), x - 1.0);
+    (
+        -y * y * l,
+        -2.0 * y * l - y * y / x,
+        -2.0 * l - 4.0 * y / x + y * y / (x * x),
+    )
 }
 
 impl Problem<'_> {
@@ -611,6 +673,13 @@ impl Problem<'_> {
                 return f64::INFINITY;
             }
             e += self.barrier_w * (self.eps / d - 1.0).powi(2);
+        }
+        for &([p, a, b], dhat) in &self.adaptive {
+            let d = tri_gap(uv, p, a, b);
+            if d.is_nan() || d <= 0.0 {
+                return f64::INFINITY;
+            }
+            e += self.adapt_w * ipc_barrier(d / dhat).0;
         }
         for &[p, a, b] in &self.pen_pairs {
             if let Some((sd, _)) = signed_gap(uv, p, a, b) {
@@ -696,6 +765,30 @@ impl Problem<'_> {
                 (b, unit(pb, pp) - unit(pb, pa)),
             ];
             for (v, gv) in gd {
+                grad[2 * v] += d1 * gv.x;
+                grad[2 * v + 1] += d1 * gv.y;
+                let s = &pat.diag_slots[v];
+                vals[s[0] as usize] += d2 * gv.x * gv.x;
+                vals[s[1] as usize] += d2 * gv.y * gv.x;
+                vals[s[2] as usize] += d2 * gv.x * gv.y;
+                vals[s[3] as usize] += d2 * gv.y * gv.y;
+            }
+        }
+        // Adaptive barrier: Gauss–Newton term b''(x)/d̂² ∇d ∇dᵀ on the 2×2 diagonal blocks
+        // (PSD since b'' ≥ 0 on (0, 1]), like the fixed barrier, so the pattern is unchanged.
+        for &([p, a, b], dhat) in &self.adaptive {
+            let d = tri_gap(uv, p, a, b);
+            if d.is_nan() || d <= 0.0 {
+                return Err(ParamError::NotCertified(format!(
+                    "boundary vertex v{p} touches boundary edge (v{a}, v{b})"
+                )));
+            }
+            let (_, b1, b2) = ipc_barrier(d / dhat);
+            if b2 == 0.0 && b1 == 0.0 {
+                continue;
+            }
+            let (d1, d2) = (self.adapt_w * b1 / dhat, self.adapt_w * b2 / (dhat * dhat));
+            for (v, gv) in tri_gap_grad(uv, p, a, b) {
                 grad[2 * v] += d1 * gv.x;
                 grad[2 * v + 1] += d1 * gv.y;
                 let s = &pat.diag_slots[v];
@@ -1071,6 +1164,12 @@ fn newton(
         },
         pen_margin: options.repair_margin * disk.mean_edge_length(),
         pen_pairs: Vec::new(),
+        adapt_w: if certified {
+            options.adaptive_barrier / disk.n_faces() as f64
+        } else {
+            0.0
+        },
+        adaptive: Vec::new(),
     };
     let clock = std::time::Instant::now();
     let mut lap = {
@@ -1236,6 +1335,17 @@ fn newton(
                     }
                 }
             }
+            // Adaptive barrier: every pair the bound found enters the objective activated at
+            // its current gap (value, gradient and Hessian 0 there: the objective and this
+            // iteration's direction are unchanged, the line search already sees the term).
+            if prob.adapt_w > 0.0 && t_coll < horizon {
+                for &[p, a, b] in &pairs {
+                    let d = tri_gap(&uv, p, a, b);
+                    if d > prob.eps && !prob.adaptive.iter().any(|(q, _)| *q == [p, a, b]) {
+                        prob.adaptive.push(([p, a, b], d));
+                    }
+                }
+            }
             log.time_ms[2] += lap();
         }
         let t_safe = options.step_fraction * t_flip;
@@ -1310,11 +1420,29 @@ fn newton(
         // relative to E itself the constant 4 would stop developable patches early.
         let rel = (energy - e_new) / (energy - 4.0).max(f64::MIN_POSITIVE);
         energy = e_new;
+        if !prob.adaptive.is_empty() {
+            // Shrink the activation gaps towards the pairs' current gaps (the objective can
+            // only fall), so closing slits can approach contact over the iterations.
+            let (gamma, eps) = (options.adaptive_shrink, prob.eps);
+            let mut changed = false;
+            prob.adaptive.retain_mut(|([p, a, b], dhat)| {
+                let cap = gamma * tri_gap(&uv, *p, *a, *b);
+                if cap < *dhat {
+                    *dhat = cap;
+                    changed = true;
+                }
+                *dhat > eps
+            });
+            if changed {
+                energy = prob.energy(&uv).min(energy);
+            }
+        }
         if !certified && prob.pen_w > 0.0 {
             // Overlap repair: done once the map is certified with every repaired vertex at
             // least half the clearance outside; else add the newly penetrating vertices.
             let clear = prob.pen_pairs.iter().all(|&[p, a, b]| {
-                signed_gap(&uv, p, a, b).is_none_or(|(sd, _)| sd <= -0.5 * prob.pen_margin)
+                signed_gap(&uv, p, a, b)
+                    .is_none_or(|(sd, _)| sd <= -options.repair_clearance * prob.pen_margin)
             });
             if clear && recertify(disk, &uv, boundary).is_ok() {
                 converged = true;
