@@ -104,6 +104,9 @@ fn main() {
                     if let Some(x) = env("AB") {
                         sd.options.adaptive_barrier = x;
                     }
+                    if let Some(x) = env("SEED") {
+                        sd.options.adaptive_seed = x;
+                    }
                     if let Some(x) = env("RC") {
                         sd.options.repair_clearance = x;
                     }
