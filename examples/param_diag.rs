@@ -101,6 +101,18 @@ fn main() {
                     if let Some(x) = env("RW") {
                         sd.options.repair_weight = x;
                     }
+                    if let Some(x) = env("AB") {
+                        sd.options.adaptive_barrier = x;
+                    }
+                    if let Some(x) = env("SEED") {
+                        sd.options.adaptive_seed = x;
+                    }
+                    if let Some(x) = env("RC") {
+                        sd.options.repair_clearance = x;
+                    }
+                    if let Some(x) = env("AS") {
+                        sd.options.adaptive_shrink = x;
+                    }
                     let r = sd.parameterize_profiled(&pm.mesh, &pm.boundary);
                     let ms = t.elapsed().as_secs_f64() * 1e3;
                     if let Ok((p, prof)) = r {
@@ -139,6 +151,18 @@ fn main() {
                         l.certificate_rejections,
                         l.collision_limited
                     );
+                    if let Some(r) = &pr.repair {
+                        for i in 0..r.steps.len() {
+                            println!(
+                                "    repair {:2} E {:.6} step {:.4} flipfree {:.4} minA {:.2e}",
+                                i + 1,
+                                r.energies[i + 1],
+                                r.steps[i],
+                                r.flip_free_steps[i],
+                                r.min_double_area[i + 1]
+                            );
+                        }
+                    }
                     for i in 0..l.steps.len() {
                         println!(
                             "    {:2} E {:.6} dec/exc {:.2e} rel {:.2e} step {:.4} flipfree {:.4}",
