@@ -1304,11 +1304,15 @@ fn smooth_pass(
     let mut metrics: Vec<Matrix3<f64>> = work.locations.iter().map(|l| field.eval_at(l)).collect();
     let mut moved = 0;
     let mut grid = FaceGrid::new(&work.mesh);
+    // `settled[v]`: no candidate of v improved its fan at its last visit and nothing in its
+    // closed 1-ring has moved since, so the same candidates would score the same again.
+    let mut settled = vec![false; work.mesh.n_vertices()];
     for _pass in 0..3 {
         for vi in 0..work.mesh.n_vertices() {
             let v = VertexId::new(vi);
             let fan = topo.vertex_faces(v);
-            if fan.is_empty()
+            if settled[vi]
+                || fan.is_empty()
                 || topo.is_boundary_vertex(v)
                 || corners.get(vi).copied().unwrap_or(false)
             {
@@ -1329,24 +1333,6 @@ fn smooth_pass(
             let before = fan_q(&work.mesh, &metrics);
             let nbrs = topo.vertex_neighbors(v);
             let old = work.mesh.positions[vi];
-            // Reference vertices under the fan (corners of the reference faces at the fan's
-            // vertices' locations) and their distance to the fan now: no move may push one
-            // of them farther than `tol` away unless it already was (then not farther).
-            let mut watch: Vec<Point3<f64>> = std::iter::once(v)
-                .chain(nbrs.iter().copied())
-                .flat_map(|u| field.reference().face(work.locations[u.idx()].face))
-                .map(|r| field.reference().positions[r.idx()])
-                .collect();
-            watch.push(old);
-            let fan_dist = |mesh: &TriMesh, x: &Point3<f64>| {
-                fan.iter()
-                    .map(|f| {
-                        let t = mesh.triangles[f.idx()].map(|u| mesh.positions[u.idx()]);
-                        point_triangle_distance(x, &t)
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            };
-            let watch_before: Vec<f64> = watch.iter().map(|x| fan_dist(&work.mesh, x)).collect();
             let c = nbrs.iter().fold(Vector3::zeros(), |acc, u| {
                 acc + work.mesh.positions[u.idx()].coords
             }) / nbrs.len() as f64;
@@ -1376,6 +1362,28 @@ fn smooth_pass(
             work.mesh.positions[vi] = old;
             metrics[vi] = old_m;
             scored.sort_by(|a, b| b.0.total_cmp(&a.0));
+            if scored.is_empty() {
+                settled[vi] = true;
+                continue;
+            }
+            // Reference vertices under the fan (corners of the reference faces at the fan's
+            // vertices' locations) and their distance to the fan now: no move may push one
+            // of them farther than `tol` away unless it already was (then not farther).
+            let mut watch: Vec<Point3<f64>> = std::iter::once(v)
+                .chain(nbrs.iter().copied())
+                .flat_map(|u| field.reference().face(work.locations[u.idx()].face))
+                .map(|r| field.reference().positions[r.idx()])
+                .collect();
+            watch.push(old);
+            let fan_dist = |mesh: &TriMesh, x: &Point3<f64>| {
+                fan.iter()
+                    .map(|f| {
+                        let t = mesh.triangles[f.idx()].map(|u| mesh.positions[u.idx()]);
+                        point_triangle_distance(x, &t)
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let watch_before: Vec<f64> = watch.iter().map(|x| fan_dist(&work.mesh, x)).collect();
             for (_, loc, p) in scored {
                 work.mesh.positions[vi] = p;
                 work.locations[vi] = loc;
@@ -1411,6 +1419,10 @@ fn smooth_pass(
             }
             if accepted {
                 moved += 1;
+                settled[vi] = false;
+                for u in &nbrs {
+                    settled[u.idx()] = false;
+                }
             }
         }
     }

@@ -243,12 +243,19 @@ fn boxes_overlap(a: &Aabb, b: &Aabb) -> bool {
 /// of the coordinates and compared with `<=`, so no intersecting pair is lost. Narrow phase:
 /// [`faces_intersect`]. The output is sorted, hence independent of thread scheduling.
 pub fn self_intersections(mesh: &TriMesh) -> Vec<(FaceId, FaceId)> {
-    let degenerate: Vec<bool> = mesh
-        .faces()
-        .collect::<Vec<_>>()
-        .par_iter()
-        .map(|&f| is_degenerate(mesh, f))
-        .collect();
+    // Small meshes (the local checks after every patch, flip and move of Algorithm 1) run on
+    // the calling thread: waking rayon's workers for a few dozen faces cost more than the
+    // test itself. The result is sorted, so it does not depend on the path taken.
+    let parallel = mesh.n_faces() >= PARALLEL_MIN_FACES;
+    let degenerate: Vec<bool> = if parallel {
+        mesh.faces()
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map(|&f| is_degenerate(mesh, f))
+            .collect()
+    } else {
+        mesh.faces().map(|f| is_degenerate(mesh, f)).collect()
+    };
     let boxes: Vec<Aabb> = mesh
         .faces()
         .map(|f| face_aabb(&mesh.face_points(f)))
@@ -260,31 +267,39 @@ pub fn self_intersections(mesh: &TriMesh) -> Vec<(FaceId, FaceId)> {
         BvhBuildStrategy::Binned,
         &leaf_face.iter().map(|&i| boxes[i]).collect::<Vec<_>>(),
     );
-    let mut pairs: Vec<(FaceId, FaceId)> = (0..mesh.n_faces())
-        .into_par_iter()
-        .flat_map_iter(|i| {
-            let mut found = Vec::new();
-            if degenerate[i] {
-                found.push((FaceId::new(i), FaceId::new(i)));
-                return found;
+    let pairs_of = |i: usize| {
+        let mut found = Vec::new();
+        if degenerate[i] {
+            found.push((FaceId::new(i), FaceId::new(i)));
+            return found;
+        }
+        for leaf in bvh.intersect_aabb(&boxes[i]) {
+            let Some(&j) = leaf_face.get(leaf as usize) else {
+                continue;
+            };
+            if j <= i || !boxes_overlap(&boxes[i], &boxes[j]) {
+                continue;
             }
-            for leaf in bvh.intersect_aabb(&boxes[i]) {
-                let Some(&j) = leaf_face.get(leaf as usize) else {
-                    continue;
-                };
-                if j <= i || !boxes_overlap(&boxes[i], &boxes[j]) {
-                    continue;
-                }
-                if faces_intersect(mesh, FaceId::new(i), FaceId::new(j)) {
-                    found.push((FaceId::new(i), FaceId::new(j)));
-                }
+            if faces_intersect(mesh, FaceId::new(i), FaceId::new(j)) {
+                found.push((FaceId::new(i), FaceId::new(j)));
             }
-            found
-        })
-        .collect();
+        }
+        found
+    };
+    let mut pairs: Vec<(FaceId, FaceId)> = if parallel {
+        (0..mesh.n_faces())
+            .into_par_iter()
+            .flat_map_iter(pairs_of)
+            .collect()
+    } else {
+        (0..mesh.n_faces()).flat_map(pairs_of).collect()
+    };
     pairs.sort_unstable();
     pairs
 }
+
+/// Below this many faces [`self_intersections`] does not use rayon.
+const PARALLEL_MIN_FACES: usize = 1024;
 
 /// No two faces intersect other than in their shared vertices and edges, and no face is
 /// degenerate (see [`self_intersections`]).
@@ -637,30 +652,34 @@ mod tests {
     #[test]
     fn broad_phase_loses_no_pair() {
         // Two overlapping spheres, one rotated so that their faces cross in general position,
-        // plus a coplanar touching case: the BVH result equals the all-pairs brute force.
-        let a = generators::icosphere(1.0, 2);
-        let b = generators::icosphere(0.8, 2);
-        let mut m = a.clone();
-        let n = m.positions.len() as u32;
-        let rot = nalgebra::Rotation3::from_euler_angles(0.3, 0.2, 0.1);
-        m.positions.extend(
-            b.positions
-                .iter()
-                .map(|p| rot * p + nalgebra::Vector3::new(0.5, 0.25, 0.0)),
-        );
-        m.triangles
-            .extend(b.triangles.iter().map(|t| t.map(|v| VertexId(v.0 + n))));
-        let fast = self_intersections(&m);
-        let mut slow = Vec::new();
-        for i in 0..m.n_faces() {
-            for j in i + 1..m.n_faces() {
-                if faces_intersect(&m, FaceId::new(i), FaceId::new(j)) {
-                    slow.push((FaceId::new(i), FaceId::new(j)));
+        // plus a coplanar touching case: the BVH result equals the all-pairs brute force, on
+        // the calling thread (640 faces) and with rayon (1,600 faces).
+        for (level_a, parallel) in [(2, false), (3, true)] {
+            let a = generators::icosphere(1.0, level_a);
+            let b = generators::icosphere(0.8, 2);
+            let mut m = a.clone();
+            let n = m.positions.len() as u32;
+            let rot = nalgebra::Rotation3::from_euler_angles(0.3, 0.2, 0.1);
+            m.positions.extend(
+                b.positions
+                    .iter()
+                    .map(|p| rot * p + nalgebra::Vector3::new(0.5, 0.25, 0.0)),
+            );
+            m.triangles
+                .extend(b.triangles.iter().map(|t| t.map(|v| VertexId(v.0 + n))));
+            assert_eq!(m.n_faces() >= PARALLEL_MIN_FACES, parallel);
+            let fast = self_intersections(&m);
+            let mut slow = Vec::new();
+            for i in 0..m.n_faces() {
+                for j in i + 1..m.n_faces() {
+                    if faces_intersect(&m, FaceId::new(i), FaceId::new(j)) {
+                        slow.push((FaceId::new(i), FaceId::new(j)));
+                    }
                 }
             }
+            assert!(slow.len() > 20, "{}", slow.len());
+            assert_eq!(fast, slow);
         }
-        assert!(slow.len() > 20, "{}", slow.len());
-        assert_eq!(fast, slow);
     }
 
     #[test]
