@@ -757,22 +757,7 @@ impl Problem<'_> {
             let r = self.eps / d;
             let d1 = self.barrier_w * 2.0 * (r - 1.0) * (-r / d);
             let d2 = self.barrier_w * (2.0 * r * r / (d * d) + 4.0 * r * (r - 1.0) / (d * d));
-            let unit = |x: Point2<f64>, y: Point2<f64>| {
-                let v = x - y;
-                let l = v.norm();
-                if l > 0.0 {
-                    v / l
-                } else {
-                    Vector2::zeros()
-                }
-            };
-            let (pp, pa, pb) = (uv[p], uv[a], uv[b]);
-            let gd = [
-                (p, unit(pp, pa) + unit(pp, pb)),
-                (a, unit(pa, pp) - unit(pa, pb)),
-                (b, unit(pb, pp) - unit(pb, pa)),
-            ];
-            for (v, gv) in gd {
+            for (v, gv) in tri_gap_grad(uv, p, a, b) {
                 grad[2 * v] += d1 * gv.x;
                 grad[2 * v + 1] += d1 * gv.y;
                 let s = &pat.diag_slots[v];
