@@ -112,3 +112,80 @@ fn bench_without_meshes_is_an_error_and_writes_no_table() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("no mesh files in"));
     assert!(!out.join("remesh.md").exists());
 }
+
+#[test]
+fn bench_refuses_inputs_it_would_overwrite_or_mix_up() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let torus = generators::torus(1.0, 0.35, 16, 8);
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    for d in [&a, &b] {
+        std::fs::create_dir(d).expect("mkdir");
+        conemesh::io::write_mesh(&d.join("t.off"), &torus).expect("write");
+    }
+    let s = |p: &std::path::Path| p.to_str().expect("utf-8").to_string();
+    let out = dir.path().join("out");
+    // Two inputs named `t`: their outputs would overwrite each other.
+    let o = bench(&[&s(&a.join("t.off")), &s(&b.join("t.off")), "-o", &s(&out)]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("share the name `t`"), "{err}");
+    assert!(!out.join("remesh.md").exists());
+    // An input inside the output folder with the output's name: it would be replaced.
+    conemesh::io::write_mesh(&a.join("u.obj"), &torus).expect("write");
+    let o = bench(&[&s(&a.join("u.obj")), "-o", &s(&a)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("overwritten by its own output"));
+    assert_eq!(
+        conemesh::io::read_mesh(&a.join("u.obj"))
+            .expect("still there")
+            .mesh
+            .n_faces(),
+        torus.n_faces()
+    );
+    // Arguments bench sets itself are refused before anything runs.
+    let o = bench(&[
+        &s(&a.join("t.off")),
+        "-o",
+        &s(&out),
+        "--",
+        "--report=x.json",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("set by bench"));
+}
+
+#[test]
+fn a_stale_report_is_not_read_as_a_failed_runs() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).expect("mkdir");
+    let broken = dir.path().join("broken.off");
+    std::fs::write(&broken, "OFF\n3 1 0\n0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n").expect("write");
+    // Leftovers of an earlier, successful run of a mesh with that name.
+    let torus = generators::torus(1.0, 0.35, 16, 8);
+    conemesh::io::write_mesh(&out.join("broken.obj"), &torus).expect("write");
+    std::fs::write(
+        out.join("broken.json"),
+        r#"{"seconds": 1.0, "run": {"faces_in": 1, "faces_out": 1, "patches": 1}}"#,
+    )
+    .expect("write");
+    let o = bench(&[
+        broken.to_str().expect("utf-8"),
+        "-o",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let table = std::fs::read_to_string(out.join("remesh.md")).expect("table");
+    assert!(row(&table, "broken")
+        .last()
+        .expect("cells")
+        .starts_with("FAILED"));
+    assert!(
+        !out.join("broken.obj").exists(),
+        "the stale output is removed"
+    );
+    assert!(
+        !out.join("broken.json").exists(),
+        "the stale report is removed"
+    );
+}

@@ -110,7 +110,7 @@ impl Numbers {
                 .map(|a| a.len())
                 .ok_or("`eval.flips` is not a list")?,
             seconds: f(&["seconds"])?,
-            peak_mb: json.get("peak_rss_mb").and_then(|v| v.as_f64()),
+            peak_mb: json.get("peak_rss_mib").and_then(|v| v.as_f64()),
         })
     }
 }
@@ -125,19 +125,59 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
     if meshes.is_empty() {
         bail!("no mesh files in {}", args.dir.display());
     }
+    // bench sets these itself; a second value would only make every run fail.
+    if let Some(a) = args.remesh_args.iter().find(|a| {
+        let name = a.split('=').next().unwrap_or(a);
+        ["-o", "--output", "--report", "-q", "--quiet"].contains(&name)
+    }) {
+        bail!("`{a}` is set by bench for every run; leave it out of the remesh arguments");
+    }
+    // Outputs are named by the input's file stem: two inputs with one stem would overwrite
+    // each other's output, report and log.
+    let mut stems: Vec<(String, &PathBuf)> = meshes.iter().map(|m| (stem(m), m)).collect();
+    stems.sort();
+    if let Some(w) = stems.windows(2).find(|w| w[0].0 == w[1].0) {
+        bail!(
+            "{} and {} share the name `{}` (outputs are named by it); bench them separately",
+            w[0].1.display(),
+            w[1].1.display(),
+            w[0].0
+        );
+    }
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;
+    // An output must not replace its input (a mesh benched from inside the output folder).
+    let out_dir = args
+        .out_dir
+        .canonicalize()
+        .with_context(|| format!("resolving {}", args.out_dir.display()))?;
+    for mesh in &meshes {
+        let input = mesh
+            .canonicalize()
+            .with_context(|| format!("reading {}", mesh.display()))?;
+        if input == out_dir.join(format!("{}.obj", stem(mesh))) {
+            bail!(
+                "{} would be overwritten by its own output; choose another --out-dir",
+                mesh.display()
+            );
+        }
+    }
     let exe = std::env::current_exe().context("locating the conemesh executable")?;
     let mut rows = Vec::new();
     for mesh in &meshes {
-        let name = mesh
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| mesh.display().to_string());
+        let name = stem(mesh);
         let out = args.out_dir.join(format!("{name}.obj"));
         let report = args.out_dir.join(format!("{name}.json"));
-        // A stale report must not be read as this run's.
-        let _ = std::fs::remove_file(&report);
+        // A stale report must not be read as this run's, nor a stale mesh stand beside a
+        // failed run.
+        for stale in [&report, &out] {
+            match std::fs::remove_file(stale) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(e).with_context(|| format!("removing {}", stale.display()));
+                }
+                _ => {}
+            }
+        }
         let t0 = Instant::now();
         let child = Command::new(&exe)
             .arg("remesh")
@@ -166,7 +206,13 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
                 .and_then(|j| Numbers::from_report(&j))
         } else {
             let stderr = String::from_utf8_lossy(&child.stderr);
-            let last = stderr.lines().rev().find(|l| !l.trim().is_empty());
+            // The error line (or a panic's message), not a trailing hint.
+            let last = stderr.lines().find(|l| l.contains("panicked")).or_else(|| {
+                stderr
+                    .lines()
+                    .rev()
+                    .find(|l| !l.trim().is_empty() && !l.starts_with("note:"))
+            });
             Err(format!(
                 "remesh failed ({}): {}",
                 child.status,
@@ -195,6 +241,18 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// A mesh's name in the table and in its output files: the file stem.
+fn stem(mesh: &Path) -> String {
+    mesh.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| mesh.display().to_string())
+}
+
+/// Text for a Markdown table cell.
+fn cell(s: &str) -> String {
+    s.replace('|', "\\|")
+}
+
 /// The mesh files of `dir`, sorted by file name.
 fn meshes_in(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let mut out = Vec::new();
@@ -219,7 +277,7 @@ fn row_text(r: &Row) -> String {
             let missed = n.missed();
             format!(
                 "| {} | {} | {} | {:.3} / {:.3} | {:.2} / {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {} | {} |",
-                r.name,
+                cell(&r.name),
                 n.faces_in,
                 n.faces_out,
                 n.q_min,
@@ -241,9 +299,9 @@ fn row_text(r: &Row) -> String {
         }
         Err(e) => format!(
             "| {} | - | - | - | - | - | - | - | - | {:.2} | - | FAILED: {} |",
-            r.name,
+            cell(&r.name),
             r.wall,
-            e.replace('|', "/")
+            cell(e)
         ),
     }
 }
@@ -254,7 +312,7 @@ fn table(rows: &[Row], remesh_args: &[String]) -> String {
         s,
         "# conemesh bench: `conemesh remesh MESH{}{}`, one process per mesh\n",
         if remesh_args.is_empty() { "" } else { " " },
-        remesh_args.join(" ")
+        remesh_args.join(" ").replace('`', "'")
     );
     let _ = writeln!(
         s,
@@ -262,13 +320,13 @@ fn table(rows: &[Row], remesh_args: &[String]) -> String {
          L_tar of the run); Hausdorff in % of the input's bounding-box diagonal; `remesh s` is the \
          run's own time (reading, metric, Algorithm 1 with its certificates), `wall s` the whole \
          process's (also `eval` and writing); \
-         peak MB is the process's peak resident memory (VmHWM). Targets (issue 9): q_avg ≥ {TARGET_Q_AVG}, \
+         peak MiB is the process's peak resident memory (VmHWM). Targets (issue 9): q_avg ≥ {TARGET_Q_AVG}, \
          θ_avg ≥ {TARGET_THETA_AVG}°, 0 flips, Hausdorff ≤ {} %.\n",
         100.0 * TARGET_HAUSDORFF_REL
     );
     let _ = writeln!(
         s,
-        "| mesh | F in | F out | q_min / q_avg | θ_min / θ_avg (°) | Hausdorff % | flips | patches | remesh s | wall s | peak MB | targets |"
+        "| mesh | F in | F out | q_min / q_avg | θ_min / θ_avg (°) | Hausdorff % | flips | patches | remesh s | wall s | peak MiB | targets |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for r in rows {

@@ -253,7 +253,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             "input": name,
             "output": args.output,
             "seconds": elapsed,
-            "peak_rss_mb": peak_rss_mb(),
+            "peak_rss_mib": peak_rss_mib(),
             "run": result.report,
             "eval": eval,
         });
@@ -274,9 +274,9 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// This process's peak resident memory in MB (`VmHWM` of `/proc/self/status`; `None` where
-/// there is no such file, i.e. off Linux).
-fn peak_rss_mb() -> Option<f64> {
+/// This process's peak resident memory in MiB (`VmHWM` of `/proc/self/status`, in kB; `None`
+/// where there is no such file, i.e. off Linux).
+fn peak_rss_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;

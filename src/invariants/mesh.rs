@@ -27,13 +27,14 @@ pub fn non_manifold_vertices(mesh: &TriMesh, topo: &Topology) -> Vec<VertexId> {
     non_manifold_vertices_among(mesh, topo, (0..topo.n_vertices()).map(VertexId::new))
 }
 
-/// [`non_manifold_vertices`] restricted to `vertices` (in their order), for a mesh that
-/// changed only around them.
+/// [`non_manifold_vertices`] restricted to `vertices` (in their order; ids out of range are
+/// skipped), for a mesh that changed only around them.
 pub fn non_manifold_vertices_among(
     mesh: &TriMesh,
     topo: &Topology,
     vertices: impl IntoIterator<Item = VertexId>,
 ) -> Vec<VertexId> {
+    let vertices = vertices.into_iter().filter(|v| v.idx() < topo.n_vertices());
     let mut out = Vec::new();
     let tris = |f: FaceId| mesh.face(f);
     fn find(p: &mut [usize], mut x: usize) -> usize {
@@ -114,14 +115,7 @@ pub fn certify_manifold_at(
             edges.iter().map(|&(e, k)| EdgeFaces(e, k)).collect(),
         )));
     }
-    let mut verts = non_manifold_vertices_among(
-        mesh,
-        topo,
-        touched
-            .iter()
-            .copied()
-            .filter(|v| v.idx() < topo.n_vertices()),
-    );
+    let mut verts = non_manifold_vertices_among(mesh, topo, touched.iter().copied());
     verts.sort_unstable();
     verts.dedup();
     if !verts.is_empty() {
@@ -546,7 +540,7 @@ mod tests {
         at(&[1, 2, 6]).unwrap();
         at(&[]).unwrap();
         assert_eq!(
-            non_manifold_vertices_among(&m, &t, [VertexId(5), VertexId(0)]),
+            non_manifold_vertices_among(&m, &t, [VertexId(5), VertexId(77), VertexId(0)]),
             vec![VertexId(5), VertexId(0)]
         );
         // A non-manifold edge is found whatever the touched vertices.
