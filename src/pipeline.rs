@@ -1217,6 +1217,9 @@ fn flip_pass(
             .collect();
         edges.sort();
         let mut touched = vec![false; work.mesh.n_faces()];
+        // Quality of each face, computed once per pass (a face is looked at from each of its
+        // three edges; a flipped face is `touched` and not looked at again in this pass).
+        let mut face_q: Vec<Option<f64>> = vec![None; work.mesh.n_faces()];
         let mut new_edges: HashSet<EdgeKey> = HashSet::new();
         let mut flipped = 0;
         for e in edges {
@@ -1242,7 +1245,9 @@ fn flip_pass(
             if edge_faces.contains_key(&cd) || new_edges.contains(&cd) {
                 continue;
             }
-            let (q1, q2) = (q(&work.mesh, t1), q(&work.mesh, t2));
+            let mut cached =
+                |f: usize, t: [VertexId; 3]| *face_q[f].get_or_insert_with(|| q(&work.mesh, t));
+            let (q1, q2) = (cached(f1, t1), cached(f2, t2));
             let n1 = [a, d, c];
             let n2 = [d, b, c];
             let (r1, r2) = (q(&work.mesh, n1), q(&work.mesh, n2));
