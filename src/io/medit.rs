@@ -30,7 +30,8 @@ fn record_tokens(key: &str, d: usize) -> Option<usize> {
         | "requiredquadrilaterals"
         | "requiredtetrahedra" => 1,
         "normals" | "tangents" => d,
-        "normalatvertices" => 2,
+        // (vertex, normal / tangent index); MMG writes both by default.
+        "normalatvertices" | "tangentatvertices" => 2,
         "normalattrianglevertices"
         | "normalatquadrilateralvertices"
         | "tangentatedgevertices"

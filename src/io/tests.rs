@@ -347,6 +347,16 @@ fn medit_reads_and_skips_sections() -> Result<(), IoError> {
         m.attributes.face_ints,
         vec![("ref".to_string(), vec![7, 0, 0])]
     );
+    // The geometry sections MMG writes after a surface remesh (ridges on): skipped by size.
+    let m = rd(
+        "MeshVersionFormatted 2\nDimension 3\nVertices\n3\n0 0 0 0\n1 0 0 0\n0 1 0 0\n\
+         Corners\n1\n1\nRequiredVertices\n1\n1\nEdges\n1\n1 2 0\nRidges\n1\n1\n\
+         Triangles\n1\n1 2 3 0\nNormals\n1\n0 0 1\nNormalAtVertices\n1\n1 1\n\
+         Tangents\n1\n1 0 0\nTangentAtVertices\n1\n2 1\nEnd\n",
+        Format::Medit,
+    )?;
+    assert_eq!(m.mesh.n_faces(), 1);
+    assert_eq!(m.mesh.n_vertices(), 3);
     let e = rd("MeshVersionFormatted 2\nDimension 3\nVertices\n3\n0 0 0 0\n1 0 0 0\n0 1 0 0\nTriangles\n1\n0 1 2 0\nEnd\n", Format::Medit).unwrap_err();
     assert!(matches!(e, IoError::BadIndex { index: 0, .. }), "{e}");
     Ok(())
