@@ -465,18 +465,22 @@ mod tests {
         }
     }
 
+    /// Corners for the small non-manifold cases below (fans meeting at v0 and v5).
+    const PINCH_POINTS: [(f64, f64, f64); 8] = [
+        (0., 0., 0.),
+        (1., 0., 0.),
+        (0.5, 1., 0.),
+        (0.5, -1., 0.),
+        (0.5, 0., 1.),
+        (-1., 0.5, 0.),
+        (-1., -0.5, 0.),
+        (-1., -0.5, 1.),
+    ];
+
     #[test]
     fn manifold_failures_name_the_elements() {
-        let p = [
-            (0., 0., 0.),
-            (1., 0., 0.),
-            (0.5, 1., 0.),
-            (0.5, -1., 0.),
-            (0.5, 0., 1.),
-            (-1., 0.5, 0.),
-            (-1., -0.5, 0.),
-        ];
-        let m = mesh(&p, &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]);
+        let p = &PINCH_POINTS[..7];
+        let m = mesh(p, &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]);
         let e = certify_manifold(&m, &Topology::build(&m)).unwrap_err();
         assert_eq!(
             e,
@@ -485,14 +489,14 @@ mod tests {
                 3
             )]))
         );
-        let m = mesh(&p, &[[0, 1, 2], [0, 5, 6]]);
+        let m = mesh(p, &[[0, 1, 2], [0, 5, 6]]);
         let e = certify_manifold(&m, &Topology::build(&m)).unwrap_err();
         assert_eq!(
             e,
             InvariantError::NonManifoldVertices(Offenders(vec![VertexId(0)]))
         );
         // A flipped neighbour is an orientation problem, not a pinch point.
-        let m = mesh(&p, &[[0, 1, 2], [0, 1, 3]]);
+        let m = mesh(p, &[[0, 1, 2], [0, 1, 3]]);
         let t = Topology::build(&m);
         certify_manifold(&m, &t).unwrap();
         assert_eq!(
@@ -509,18 +513,9 @@ mod tests {
     /// whenever the offending vertex is among them.
     #[test]
     fn local_manifold_certificate_checks_the_touched_vertices_and_every_edge() {
-        let p = [
-            (0., 0., 0.),
-            (1., 0., 0.),
-            (0.5, 1., 0.),
-            (0.5, -1., 0.),
-            (0.5, 0., 1.),
-            (-1., 0.5, 0.),
-            (-1., -0.5, 0.),
-            (-1., -0.5, 1.),
-        ];
+        let p = &PINCH_POINTS;
         // Two fans pinched at v0, and a second pinch at v5 (faces 1 and 2 meet only there).
-        let m = mesh(&p, &[[0, 1, 2], [0, 5, 6], [5, 3, 7]]);
+        let m = mesh(p, &[[0, 1, 2], [0, 5, 6], [5, 3, 7]]);
         let t = Topology::build(&m);
         let whole = certify_manifold(&m, &t).unwrap_err();
         assert_eq!(
@@ -544,7 +539,7 @@ mod tests {
             vec![VertexId(5), VertexId(0)]
         );
         // A non-manifold edge is found whatever the touched vertices.
-        let m = mesh(&p, &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]);
+        let m = mesh(p, &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]);
         let t = Topology::build(&m);
         assert_eq!(
             certify_manifold_at(&m, &t, &[]).unwrap_err(),

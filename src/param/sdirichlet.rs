@@ -1826,6 +1826,23 @@ mod tests {
         assert!(err < 1e-9, "{err}");
     }
 
+    /// The disk's boundary and its certified cotan Tutte map (the optimiser tests' start).
+    fn cotan_tutte_start(disk: &TriMesh) -> (Vec<VertexId>, Vec<Point2<f64>>) {
+        let boundary = super::super::disk_boundary(disk).unwrap();
+        let (uv0, _) = certified_tutte(disk, &boundary, TutteWeights::Cotan).unwrap();
+        (boundary, uv0)
+    }
+
+    /// The certified Newton optimisation from `uv0` (panics if it fails).
+    fn certified_newton(
+        disk: &TriMesh,
+        boundary: &[VertexId],
+        uv0: &[Point2<f64>],
+        o: &SdOptions,
+    ) -> (Vec<Point2<f64>>, SdLog) {
+        newton(disk, boundary, uv0, o, true, &OnceCell::new(), &[]).unwrap()
+    }
+
     #[test]
     fn decrement_stop_skips_only_the_tail() {
         // A spherical cap (not developable: the optimum keeps an excess E − 4 > 0) from its
@@ -1834,14 +1851,17 @@ mod tests {
         for p in &mut disk.positions {
             p.z = (4.0 - p.x * p.x - p.y * p.y).sqrt();
         }
-        let boundary = super::super::disk_boundary(&disk).unwrap();
-        let (uv0, _) = certified_tutte(&disk, &boundary, TutteWeights::Cotan).unwrap();
+        let (boundary, uv0) = cotan_tutte_start(&disk);
         let run = |decrement_tol: f64| {
-            let o = SdOptions {
-                decrement_tol,
-                ..Default::default()
-            };
-            newton(&disk, &boundary, &uv0, &o, true, &OnceCell::new(), &[]).unwrap()
+            certified_newton(
+                &disk,
+                &boundary,
+                &uv0,
+                &SdOptions {
+                    decrement_tol,
+                    ..Default::default()
+                },
+            )
         };
         let (uv_full, full) = run(0.0);
         let (uv_tail, tail) = run(3e-3);
@@ -1920,14 +1940,17 @@ mod tests {
     #[test]
     fn adaptive_barrier_on_a_closing_slit() {
         let disk = helicoid_slit(std::f64::consts::TAU + 0.4, 4, 48);
-        let boundary = super::super::disk_boundary(&disk).unwrap();
-        let (uv0, _) = certified_tutte(&disk, &boundary, TutteWeights::Cotan).unwrap();
+        let (boundary, uv0) = cotan_tutte_start(&disk);
         let run = |adaptive_barrier: f64| {
-            let o = SdOptions {
-                adaptive_barrier,
-                ..Default::default()
-            };
-            newton(&disk, &boundary, &uv0, &o, true, &OnceCell::new(), &[]).unwrap()
+            certified_newton(
+                &disk,
+                &boundary,
+                &uv0,
+                &SdOptions {
+                    adaptive_barrier,
+                    ..Default::default()
+                },
+            )
         };
         let (_, off) = run(0.0);
         let (uv, on) = run(0.1);
