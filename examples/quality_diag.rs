@@ -27,6 +27,7 @@ fn main() {
             .ok()
             .and_then(|s| s.parse().ok())
             .unwrap_or(1),
+        feature_angle: std::env::var("FEATURE").ok().and_then(|s| s.parse().ok()),
         ..RemeshOptions::default()
     };
     let res = remesh(&field, &Stages::default(), &options, |_| {}).expect("run");
@@ -109,8 +110,26 @@ fn main() {
         let b: [u64; 3] = out.positions[v.idx()].coords.map(f64::to_bits).into();
         corner_pos.contains(&b)
     };
+    // Output vertices on a feature line (`FEATURE` degrees): located on a sharp input edge.
+    let sharp: std::collections::HashSet<EdgeKey> = match options.feature_angle {
+        Some(a) => {
+            let topo = conemesh::Topology::build(&unit);
+            conemesh::features::sharp_edges(&unit, &topo, a)
+                .into_iter()
+                .collect()
+        }
+        None => Default::default(),
+    };
+    let on_feature = |v: conemesh::VertexId| {
+        let l = res.locations[v.idx()];
+        let t = unit.triangles[l.face.idx()];
+        (0..3).any(|k| {
+            l.bary[(k + 2) % 3] == 0.0 && sharp.contains(&EdgeKey::new(t[k], t[(k + 1) % 3]))
+        })
+    };
     let classes = [
         "kept",
+        "feature",
         "corner fan",
         "near SI",
         "seam edge",
@@ -128,18 +147,20 @@ fn main() {
             .unwrap_or(false);
         let class = if res.face_patch[f].is_none() {
             0
-        } else if t.iter().any(|v| at_corner(*v)) {
+        } else if t.iter().any(|v| on_feature(*v)) {
             1
-        } else if near_si {
+        } else if t.iter().any(|v| at_corner(*v)) {
             2
-        } else if on_seam[f] {
+        } else if near_si {
             3
-        } else if t.iter().any(|v| seam_vertex[v.idx()]) {
+        } else if on_seam[f] {
             4
-        } else if res.face_patch[f].map(|p| retried[p.idx()]).unwrap_or(false) {
+        } else if t.iter().any(|v| seam_vertex[v.idx()]) {
             5
-        } else {
+        } else if res.face_patch[f].map(|p| retried[p.idx()]).unwrap_or(false) {
             6
+        } else {
+            7
         };
         let s = &mut stats[class];
         s.0 += 1;

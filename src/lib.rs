@@ -13,6 +13,7 @@
 
 pub mod check;
 pub mod error;
+pub mod features;
 pub mod fidelity;
 pub mod ids;
 pub mod invariants;

@@ -102,10 +102,27 @@ pub enum PipelineError {
         /// the corner vertex
         vertex: VertexId,
     },
+    /// The patch strategy returned a patch that crosses a feature line (contrary to
+    /// [`crate::patches::PatchContext::feature_edges`]).
+    #[error(
+        "patch {patch} (seed {seed}) contains the feature-line edge {edge} in its interior; the strategy must keep feature edges on patch boundaries"
+    )]
+    FeatureInterior {
+        /// which patch
+        patch: PatchId,
+        /// its seed
+        seed: VertexId,
+        /// the feature edge
+        edge: EdgeKey,
+    },
     /// A corner vertex of the input ([`RemeshOptions::corner_defect`]) is not in the output
     /// at its input position.
     #[error("final mesh: the input's corner vertex {0} was removed or moved")]
     CornerLost(VertexId),
+    /// A piece of a feature line ([`RemeshOptions::feature_angle`]) is not an edge of the
+    /// output, or one of its vertices moved.
+    #[error("final mesh: the feature-line edge {0} was removed or moved")]
+    FeatureLost(EdgeKey),
     /// The patch budget ran out.
     #[error("stopped after {0} patches (--max-patches) with {1} faces unprocessed")]
     Budget(usize, usize),
@@ -173,6 +190,11 @@ pub struct RemeshOptions {
     /// patch contains them in its interior and the relocation pass does not move them.
     /// `None` keeps no vertex (the paper). Default `Some(1.0)`.
     pub corner_defect: Option<f64>,
+    /// Feature lines (our addition, [`crate::features`]): input edges whose faces' normals
+    /// differ by more than this many degrees are split to the target length and kept as
+    /// edges of the output (no patch crosses them, no pass moves or flips them). `None`
+    /// keeps none (the paper).
+    pub feature_angle: Option<f64>,
 }
 
 impl Default for RemeshOptions {
@@ -191,6 +213,7 @@ impl Default for RemeshOptions {
             edge_flips: true,
             relocate: true,
             corner_defect: Some(1.0),
+            feature_angle: None,
         }
     }
 }
@@ -355,6 +378,11 @@ pub struct RemeshReport {
     /// Input vertices kept as corners ([`RemeshOptions::corner_defect`]); each is certified
     /// to be a vertex of the output at its input position.
     pub corners: usize,
+    /// Input edges kept as feature lines ([`RemeshOptions::feature_angle`]).
+    pub feature_edges: usize,
+    /// The pieces they were split into; each is certified to be an edge of the output, its
+    /// vertices where the split put them.
+    pub feature_pieces: usize,
 }
 
 /// Progress reported after every patch.
@@ -457,9 +485,6 @@ pub fn remesh(
     };
     let embedded_input = options.check_self_intersections && input_pairs == 0;
     let mut work = WorkingMesh::from_reference(reference);
-    // Provenance of every working-mesh face, kept parallel to its triangles (`stitch` drops
-    // the patch's faces in order and appends the new ones).
-    let mut face_patch: Vec<Option<PatchId>> = vec![None; work.mesh.n_faces()];
     let ref_topo = Topology::build(reference);
     // The input must be an oriented 2-manifold (with boundary): say so up front, naming the
     // elements, rather than failing later inside a patch.
@@ -481,6 +506,37 @@ pub fn remesh(
         None => Vec::new(),
     };
     let n_corners = corners.iter().filter(|c| **c).count();
+    // Feature lines: split to the target length before the loop (new vertices on the input
+    // edges), then kept as patch boundaries.
+    let sharp = match options.feature_angle {
+        Some(a) if !(a.is_finite() && a > 0.0 && a < 180.0) => {
+            return Err(PipelineError::Input(format!(
+                "feature angle must be between 0 and 180 degrees, got {a}"
+            )))
+        }
+        Some(a) => crate::features::sharp_edges(reference, &ref_topo, a),
+        None => Vec::new(),
+    };
+    let features = match sharp.is_empty() {
+        true => crate::features::FeatureLines::default(),
+        false => {
+            let m = field.vertex_metrics();
+            crate::features::split_feature_edges(&mut work, reference, &sharp, |e| {
+                let d = reference.positions[e.1.idx()] - reference.positions[e.0.idx()];
+                let mm = (m[e.0.idx()] + m[e.1.idx()]) * 0.5;
+                let len = d.dot(&(mm * d)).max(0.0).sqrt();
+                (len / l_tar).round().max(1.0) as usize
+            })
+        }
+    };
+    // Vertices no pass may move: corners and feature-line vertices.
+    let pinned: Vec<bool> = (0..work.mesh.n_vertices())
+        .map(|v| corners.get(v).copied().unwrap_or(false) || features.is_pinned(VertexId::new(v)))
+        .collect();
+    let feature_edges = (!features.edges.is_empty()).then_some(&features.edges);
+    // Provenance of every working-mesh face, kept parallel to its triangles (`stitch` drops
+    // the patch's faces in order and appends the new ones).
+    let mut face_patch: Vec<Option<PatchId>> = vec![None; work.mesh.n_faces()];
     // The input's boundary edges, by vertex ids (input vertices are never renumbered during
     // the loop and boundary vertices are never moved: the remesher keeps patch boundaries).
     let input_boundary: Vec<EdgeKey> = ref_topo
@@ -492,7 +548,11 @@ pub fn remesh(
     let mut times = StageTimes::default();
     let mut cert = Certificate::default();
     let mut records = Vec::new();
-    let mut topo = ref_topo.clone();
+    let mut topo = if features.edges.is_empty() {
+        ref_topo.clone()
+    } else {
+        Topology::build(&work.mesh)
+    };
 
     let mut n_patch = 0usize;
     let mut fallback = Fallbacks::default();
@@ -522,7 +582,7 @@ pub fn remesh(
             mesh: &work.mesh,
             topology: &topo,
             processed: &work.processed,
-            feature_edges: None,
+            feature_edges,
             corners: Some(&corners),
         };
         let patch = match stages.patches.next_patch(&ctx, &mut rng) {
@@ -576,6 +636,15 @@ pub fn remesh(
                     patch: pid,
                     seed,
                     vertex,
+                });
+            }
+            if let Some(edge) =
+                feature_edges.and_then(|fe| interior_feature(&work.mesh, &faces, fe))
+            {
+                return Err(PipelineError::FeatureInterior {
+                    patch: pid,
+                    seed,
+                    edge,
                 });
             }
             times.patches += t0.elapsed().as_secs_f64();
@@ -676,6 +745,7 @@ pub fn remesh(
                         patch.seed_face,
                         faces.len() / 2,
                         &corners,
+                        feature_edges,
                     );
                 }
             }
@@ -746,7 +816,14 @@ pub fn remesh(
             FidelityOptions::default().max_deviation
         };
         if options.edge_flips {
-            edge_flips = flip_pass(quality_field, &flip_test, &mut work, embedded_input, tol);
+            edge_flips = flip_pass(
+                quality_field,
+                &flip_test,
+                &mut work,
+                embedded_input,
+                tol,
+                feature_edges,
+            );
         }
         if options.relocate {
             vertex_moves = smooth_pass(
@@ -755,9 +832,16 @@ pub fn remesh(
                 &mut work,
                 embedded_input,
                 tol,
-                &corners,
+                &pinned,
             );
-            edge_flips += flip_pass(quality_field, &flip_test, &mut work, embedded_input, tol);
+            edge_flips += flip_pass(
+                quality_field,
+                &flip_test,
+                &mut work,
+                embedded_input,
+                tol,
+                feature_edges,
+            );
         }
         times.certify += t0.elapsed().as_secs_f64();
     }
@@ -802,6 +886,25 @@ pub fn remesh(
         .find(|&v| corners[v] && (!used[v] || work.mesh.positions[v] != reference.positions[v]))
     {
         return Err(PipelineError::CornerLost(VertexId::new(v)));
+    }
+    // Every feature-line piece is still an edge of the working mesh, its vertices unmoved.
+    if !features.edges.is_empty() {
+        let edges: HashSet<EdgeKey> = work
+            .mesh
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| EdgeKey::new(t[k], t[(k + 1) % 3])))
+            .collect();
+        let mut pieces: Vec<EdgeKey> = features.edges.iter().copied().collect();
+        pieces.sort_unstable();
+        if let Some(e) = pieces.into_iter().find(|e| {
+            !edges.contains(e)
+                || [e.0, e.1]
+                    .iter()
+                    .any(|v| features.positions.get(v) != work.mesh.positions.get(v.idx()))
+        }) {
+            return Err(PipelineError::FeatureLost(e));
+        }
     }
     times.certify += t0.elapsed().as_secs_f64();
     work.compact();
@@ -849,6 +952,8 @@ pub fn remesh(
         edge_flips,
         vertex_moves,
         corners: n_corners,
+        feature_edges: features.input_edges,
+        feature_pieces: features.edges.len(),
     };
     Ok(RemeshResult {
         mesh: work.mesh,
@@ -1187,6 +1292,7 @@ fn flip_pass(
     work: &mut WorkingMesh,
     embedded_input: bool,
     tol: f64,
+    feature_edges: Option<&HashSet<EdgeKey>>,
 ) -> usize {
     use crate::quality::{face_metric, triangle_quality};
     let metrics: Vec<Matrix3<f64>> = work.locations.iter().map(|l| field.eval_at(l)).collect();
@@ -1212,7 +1318,7 @@ fn flip_pass(
         }
         let mut edges: Vec<EdgeKey> = edge_faces
             .iter()
-            .filter(|(_, fs)| fs.len() == 2)
+            .filter(|(e, fs)| fs.len() == 2 && !feature_edges.is_some_and(|fe| fe.contains(e)))
             .map(|(e, _)| *e)
             .collect();
         edges.sort();
@@ -1558,6 +1664,26 @@ fn interior_corner(
 /// A smaller disk inside `faces`: grown face by face (breadth first, exact disk rule) from
 /// `seed_face` if it is unprocessed, else from the first unprocessed face, up to `target`
 /// faces. Deterministic.
+/// A feature edge shared by two faces of the patch (so inside it), the smallest if several.
+fn interior_feature(
+    mesh: &TriMesh,
+    faces: &[FaceId],
+    feature_edges: &HashSet<EdgeKey>,
+) -> Option<EdgeKey> {
+    let mut count: std::collections::HashMap<EdgeKey, u32> = std::collections::HashMap::new();
+    for f in faces {
+        let t = mesh.triangles[f.idx()];
+        for k in 0..3 {
+            *count.entry(EdgeKey::new(t[k], t[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    count
+        .into_iter()
+        .filter(|(e, c)| *c >= 2 && feature_edges.contains(e))
+        .map(|(e, _)| e)
+        .min()
+}
+
 fn shrink_patch(
     work: &WorkingMesh,
     topo: &Topology,
@@ -1565,6 +1691,7 @@ fn shrink_patch(
     seed_face: FaceId,
     target: usize,
     corners: &[bool],
+    feature_edges: Option<&HashSet<EdgeKey>>,
 ) -> Vec<FaceId> {
     let inside: HashSet<FaceId> = faces.iter().copied().collect();
     let start = if inside.contains(&seed_face) && !work.processed[seed_face.idx()] {
@@ -1579,7 +1706,7 @@ fn shrink_patch(
         mesh: &work.mesh,
         topology: topo,
         processed: &work.processed,
-        feature_edges: None,
+        feature_edges,
         corners: Some(corners),
     };
     let mut disk = DiskPatch::new(&ctx, start);
@@ -2053,7 +2180,10 @@ mod tests {
                 .fold(f64::INFINITY, f64::min)
         };
         let before = q_min(&work);
-        assert_eq!(flip_pass(&field, &flip_test, &mut work, true, 0.01), 1);
+        assert_eq!(
+            flip_pass(&field, &flip_test, &mut work, true, 0.01, None),
+            1
+        );
         let after = q_min(&work);
         assert!(after > before + 0.3, "q_min {before} -> {after}");
         let edges: HashSet<EdgeKey> = work
@@ -2068,7 +2198,23 @@ mod tests {
         assert!(topo.is_oriented_manifold());
         assert_eq!(topo.boundary_loops().len(), 1);
         // Nothing left to improve.
-        assert_eq!(flip_pass(&field, &flip_test, &mut work, true, 0.01), 0);
+        assert_eq!(
+            flip_pass(&field, &flip_test, &mut work, true, 0.01, None),
+            0
+        );
+    }
+
+    /// The same skinny pair is not flipped when its diagonal is a feature-line edge.
+    #[test]
+    fn flip_pass_never_flips_a_feature_edge() {
+        let (field, mut work, flip_test) = rhombus(0.0);
+        let before = work.mesh.triangles.clone();
+        let feature: HashSet<EdgeKey> = [EdgeKey::new(VertexId(0), VertexId(1))].into();
+        assert_eq!(
+            flip_pass(&field, &flip_test, &mut work, true, 0.01, Some(&feature)),
+            0
+        );
+        assert_eq!(work.mesh.triangles, before);
     }
 
     /// On a ridge the flip would cut the surface by the ridge height (0.05 > tol 0.01): kept.
@@ -2076,10 +2222,13 @@ mod tests {
     fn flip_pass_keeps_a_ridge_beyond_the_tolerance() {
         let (field, mut work, flip_test) = rhombus(0.05);
         let before = work.mesh.triangles.clone();
-        assert_eq!(flip_pass(&field, &flip_test, &mut work, true, 0.01), 0);
+        assert_eq!(
+            flip_pass(&field, &flip_test, &mut work, true, 0.01, None),
+            0
+        );
         assert_eq!(work.mesh.triangles, before);
         // With a tolerance above the ridge height the same flip is made.
-        assert_eq!(flip_pass(&field, &flip_test, &mut work, true, 0.1), 1);
+        assert_eq!(flip_pass(&field, &flip_test, &mut work, true, 0.1, None), 1);
     }
 
     /// A flat hexagonal fan whose centre sits near one corner: relocation moves it towards

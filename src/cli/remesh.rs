@@ -68,6 +68,11 @@ pub struct RemeshArgs {
     /// (tips, cone points, corners) as output vertices. 0 keeps none (the paper).
     #[arg(long, default_value_t = 1.0)]
     pub corner_defect: f64,
+    /// Keep input edges whose two faces' normals differ by more than this many degrees as
+    /// feature lines: split to the target length and kept as output edges. 0 keeps none
+    /// (the paper).
+    #[arg(long, default_value_t = 0.0)]
+    pub feature_angle: f64,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -157,6 +162,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         })),
         sweeps: args.sweeps,
         corner_defect: (args.corner_defect != 0.0).then_some(args.corner_defect),
+        feature_angle: (args.feature_angle != 0.0).then_some(args.feature_angle),
         ..RemeshOptions::default()
     };
     let total = field.reference().n_faces() as u64;

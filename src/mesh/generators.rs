@@ -170,6 +170,57 @@ pub fn cone_piece(half_angle: f64, angle: f64, s0: f64, s1: f64, nu: usize, nv: 
     })
 }
 
+/// A lens: two equal spherical caps glued along the unit circle in the xy plane, each cap
+/// meeting the plane at `alpha` radians, so the equator is a crease where the surface
+/// normals differ by `π − 2·alpha`. `rings` rings per cap from pole to
+/// equator, `sectors` vertices per ring. Closed, genus 0; for sharp-feature tests.
+pub fn lens(alpha: f64, rings: usize, sectors: usize) -> TriMesh {
+    let big_r = 1.0 / alpha.sin();
+    let c = big_r * alpha.cos();
+    // Ring k of the upper cap (k = 0 the pole, k = rings the equator).
+    let point = |k: usize, j: usize, up: bool| {
+        let th = alpha * k as f64 / rings as f64;
+        let ph = 2.0 * PI * j as f64 / sectors as f64;
+        let z = -c + big_r * th.cos();
+        let z = if k == rings { 0.0 } else { z };
+        Point3::new(
+            big_r * th.sin() * ph.cos(),
+            big_r * th.sin() * ph.sin(),
+            if up { z } else { -z },
+        )
+    };
+    // Vertex ids: 0 north pole, then the upper rings 1..=rings (the equator last), then the
+    // lower rings rings-1..=1, then the south pole.
+    let mut pos = vec![point(0, 0, true)];
+    let mut ring_ids: Vec<Vec<usize>> = vec![vec![0; sectors]];
+    for k in 1..=rings {
+        ring_ids.push((0..sectors).map(|j| pos.len() + j).collect());
+        pos.extend((0..sectors).map(|j| point(k, j, true)));
+    }
+    for k in (1..rings).rev() {
+        ring_ids.push((0..sectors).map(|j| pos.len() + j).collect());
+        pos.extend((0..sectors).map(|j| point(k, j, false)));
+    }
+    let south = pos.len();
+    pos.push(point(0, 0, false));
+    ring_ids.push(vec![south; sectors]);
+    let mut tris = Vec::new();
+    for w in ring_ids.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        for j in 0..sectors {
+            let jn = (j + 1) % sectors;
+            // Counter-clockwise seen from outside: going down from the north pole, φ grows.
+            if a[j] != a[jn] {
+                tris.push([a[j], b[j], a[jn]]);
+            }
+            if b[j] != b[jn] {
+                tris.push([a[jn], b[j], b[jn]]);
+            }
+        }
+    }
+    build(pos, tris)
+}
+
 /// Flat disk of radius `r` in the xy plane (normal +z) with `rings` concentric rings and
 /// `sectors` segments in the first ring (ring k has k·sectors vertices). One boundary loop.
 pub fn disk(r: f64, rings: usize, sectors: usize) -> TriMesh {

@@ -1,0 +1,263 @@
+//! Feature lines (our addition; the paper's Sec. 3.2 only relies on its cone patches stopping
+//! at sharp features, Fig. 1 and 12).
+//!
+//! A *feature edge* is an input edge whose two faces' normals differ by more than a threshold
+//! angle (a crease of the piecewise-flat input). Before Algorithm 1 starts, every feature edge
+//! of the working mesh is split into pieces of about the target metric length, at points on
+//! the input edge itself (so the crease is reproduced exactly, not cut by chords). The pieces
+//! are passed to the patch strategy as edges no patch may contain in its interior
+//! ([`crate::patches::PatchContext::feature_edges`]): they stay patch boundaries, which the
+//! planar remesher keeps, so they are edges of the output. Their vertices are pinned (the
+//! relocation pass does not move them) and the flip pass does not flip them.
+//!
+//! Why split first: a patch boundary is fixed, and the input's own edges are 2–3× longer than
+//! the target on a coarse input (decimated-knight), which costs the triangles along them their
+//! quality. Split to the target length, the patch beside a crease is remeshed as everywhere
+//! else.
+
+use crate::ids::{EdgeKey, FaceId, VertexId};
+use crate::mesh::{SurfaceLocation, Topology, TriMesh};
+use crate::stitch::WorkingMesh;
+use nalgebra::Point3;
+use std::collections::{HashMap, HashSet};
+
+/// The feature lines of a working mesh after [`split_feature_edges`].
+#[derive(Clone, Debug, Default)]
+pub struct FeatureLines {
+    /// The pieces of the input's feature edges, by working-mesh vertex ids.
+    pub edges: HashSet<EdgeKey>,
+    /// `pinned[v]`: working-mesh vertex `v` lies on a feature line (vertices past the end do
+    /// not).
+    pub pinned: Vec<bool>,
+    /// Where each feature-line vertex was put (the certificate after the loop compares).
+    pub positions: HashMap<VertexId, Point3<f64>>,
+    /// Number of input edges that are feature edges.
+    pub input_edges: usize,
+}
+
+impl FeatureLines {
+    /// True when `v` lies on a feature line.
+    pub fn is_pinned(&self, v: VertexId) -> bool {
+        self.pinned.get(v.idx()).copied().unwrap_or(false)
+    }
+}
+
+/// Interior edges of `mesh` whose two faces' unit normals make an angle larger than
+/// `angle_deg` degrees, sorted. Edges of zero-area faces are skipped (no normal).
+pub fn sharp_edges(mesh: &TriMesh, topo: &Topology, angle_deg: f64) -> Vec<EdgeKey> {
+    let cos_max = angle_deg.to_radians().cos();
+    let mut out = Vec::new();
+    for f in mesh.faces() {
+        let t = mesh.face(f);
+        for i in 0..3 {
+            let Some(g) = topo.neighbor(f, i) else {
+                continue;
+            };
+            // Each interior edge once, from its smaller face.
+            if g <= f {
+                continue;
+            }
+            let (n1, n2) = (mesh.face_normal_raw(f), mesh.face_normal_raw(g));
+            let (l1, l2) = (n1.norm(), n2.norm());
+            if l1 == 0.0 || l2 == 0.0 {
+                continue;
+            }
+            if n1.dot(&n2) / (l1 * l2) < cos_max {
+                out.push(EdgeKey::new(t[i], t[(i + 1) % 3]));
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Split every edge of `edges` (input edges, present in `work` as they are in `reference`)
+/// into `pieces(e)` equal parts at points on the edge, splitting both faces beside it into
+/// fans. The new vertices are located on the reference face beside the edge; the new faces
+/// are unprocessed. Returns the pieces and the pinned vertices.
+pub fn split_feature_edges(
+    work: &mut WorkingMesh,
+    reference: &TriMesh,
+    edges: &[EdgeKey],
+    mut pieces: impl FnMut(EdgeKey) -> usize,
+) -> FeatureLines {
+    // Directed edge → the face that has it (the working mesh is an oriented manifold).
+    let mut directed: HashMap<(VertexId, VertexId), usize> = HashMap::new();
+    for (f, t) in work.mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            directed.insert((t[k], t[(k + 1) % 3]), f);
+        }
+    }
+    let on_reference: HashMap<(VertexId, VertexId), FaceId> = reference
+        .faces()
+        .flat_map(|f| {
+            let t = reference.face(f);
+            (0..3).map(move |k| ((t[k], t[(k + 1) % 3]), f))
+        })
+        .collect();
+    let mut lines = FeatureLines {
+        input_edges: edges.len(),
+        ..FeatureLines::default()
+    };
+    let mut pinned: Vec<VertexId> = Vec::new();
+    for &e in edges {
+        let (a, b) = (e.0, e.1);
+        pinned.extend([a, b]);
+        let k = pieces(e).max(1);
+        let (Some(&f1), Some(&f2)) = (directed.get(&(a, b)), directed.get(&(b, a))) else {
+            // Not an interior edge of the working mesh: keep it whole (still a feature).
+            lines.edges.insert(e);
+            continue;
+        };
+        if k == 1 {
+            lines.edges.insert(e);
+            continue;
+        }
+        // The reference face with the directed edge a→b (the working face f1 is it, or a
+        // piece of it, before the loop): the new points are located on it.
+        let Some(&loc_face) = on_reference.get(&(a, b)) else {
+            lines.edges.insert(e);
+            continue;
+        };
+        let rt = reference.face(loc_face);
+        let slot = |v: VertexId| rt.iter().position(|&u| u == v);
+        let (Some(ia), Some(ib)) = (slot(a), slot(b)) else {
+            lines.edges.insert(e);
+            continue;
+        };
+        let mut chain = vec![a];
+        for j in 1..k {
+            let s = j as f64 / k as f64;
+            let mut bary = [0.0; 3];
+            bary[ia] = 1.0 - s;
+            bary[ib] = s;
+            let loc = SurfaceLocation {
+                face: loc_face,
+                bary,
+            };
+            let v = VertexId::new(work.mesh.positions.len());
+            work.mesh.positions.push(loc.position(reference));
+            work.locations.push(loc);
+            chain.push(v);
+            pinned.push(v);
+        }
+        chain.push(b);
+        for w in chain.windows(2) {
+            lines.edges.insert(EdgeKey::new(w[0], w[1]));
+        }
+        // f1 = (a, b, c) → (chain[i], chain[i+1], c); f2 = (b, a, d) → (chain[i+1], chain[i], d).
+        for (f, forward) in [(f1, true), (f2, false)] {
+            let t = work.mesh.triangles[f];
+            let apex = t.iter().copied().find(|v| *v != a && *v != b).unwrap_or(a);
+            for k in 0..3 {
+                directed.remove(&(t[k], t[(k + 1) % 3]));
+            }
+            for (i, w) in chain.windows(2).enumerate() {
+                let tri = if forward {
+                    [w[0], w[1], apex]
+                } else {
+                    [w[1], w[0], apex]
+                };
+                let slot = if i == 0 {
+                    work.mesh.triangles[f] = tri;
+                    f
+                } else {
+                    work.mesh.triangles.push(tri);
+                    work.processed.push(false);
+                    work.mesh.triangles.len() - 1
+                };
+                for k in 0..3 {
+                    directed.insert((tri[k], tri[(k + 1) % 3]), slot);
+                }
+            }
+        }
+    }
+    let mut flags = vec![false; work.mesh.n_vertices()];
+    for v in pinned {
+        flags[v.idx()] = true;
+        lines.positions.insert(v, work.mesh.positions[v.idx()]);
+    }
+    lines.pinned = flags;
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generators;
+
+    fn equator(m: &TriMesh) -> Vec<EdgeKey> {
+        let on = |v: VertexId| m.positions[v.idx()].z == 0.0;
+        let mut e: Vec<EdgeKey> = m
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .filter(|(a, b)| on(*a) && on(*b))
+            .map(|(a, b)| EdgeKey::new(a, b))
+            .collect();
+        e.sort_unstable();
+        e.dedup();
+        e
+    }
+
+    /// The lens's faces meet at the equator at 180° − 2·50° = 80° between their normals (plus
+    /// about 8° from the discretisation), elsewhere at a few degrees: a threshold between
+    /// finds exactly the equator.
+    #[test]
+    fn sharp_edges_of_a_lens_are_its_equator() {
+        let m = generators::lens(50f64.to_radians(), 6, 32);
+        let topo = Topology::build(&m);
+        assert!(topo.is_oriented_manifold());
+        let eq = equator(&m);
+        assert_eq!(eq.len(), 32);
+        assert_eq!(sharp_edges(&m, &topo, 60.0), eq);
+        assert_eq!(sharp_edges(&m, &topo, 30.0), eq);
+        assert!(sharp_edges(&m, &topo, 95.0).is_empty());
+        // A smooth sphere has none at 30°.
+        let s = generators::icosphere(1.0, 3);
+        assert!(sharp_edges(&s, &Topology::build(&s), 30.0).is_empty());
+    }
+
+    /// Splitting keeps an oriented manifold of the same topology and area; every new vertex
+    /// lies on its input edge (located there exactly), and the pieces chain the equator.
+    #[test]
+    fn split_keeps_the_surface_and_chains_the_feature() {
+        let m = generators::lens(50f64.to_radians(), 6, 32);
+        let topo = Topology::build(&m);
+        let eq = sharp_edges(&m, &topo, 60.0);
+        let mut w = WorkingMesh::from_reference(&m);
+        let lines = split_feature_edges(&mut w, &m, &eq, |e| 1 + e.0.idx() % 3);
+        let expect_new: usize = eq.iter().map(|e| e.0.idx() % 3).sum();
+        assert_eq!(w.mesh.n_vertices(), m.n_vertices() + expect_new);
+        assert_eq!(w.mesh.n_faces(), m.n_faces() + 2 * expect_new);
+        assert_eq!(w.processed.len(), w.mesh.n_faces());
+        assert!(w.processed.iter().all(|p| !p));
+        assert_eq!(lines.input_edges, 32);
+        assert_eq!(lines.edges.len(), 32 + expect_new);
+        let t2 = Topology::build(&w.mesh);
+        assert!(t2.is_oriented_manifold());
+        assert_eq!(t2.euler_characteristic(), topo.euler_characteristic());
+        assert!((w.mesh.area() - m.area()).abs() < 1e-12 * m.area());
+        // No face lost its orientation against the face it came from.
+        for f in w.mesh.faces() {
+            let n = w.mesh.face_normal_raw(f);
+            let c = w.mesh.face_centroid(f);
+            assert!(n.norm() > 0.0, "{f} degenerate");
+            assert!(n.dot(&c.coords) > 0.0, "{f} faces inwards");
+        }
+        for v in m.n_vertices()..w.mesh.n_vertices() {
+            let v = VertexId::new(v);
+            assert!(lines.is_pinned(v));
+            let p = w.mesh.positions[v.idx()];
+            assert_eq!(p.z, 0.0, "{v} off the equator plane");
+            assert_eq!(w.locations[v.idx()].position(&m), p);
+            assert!(lines.edges.iter().filter(|e| e.0 == v || e.1 == v).count() == 2);
+        }
+        // Every pinned vertex is on the equator, every equator vertex is pinned.
+        for v in 0..m.n_vertices() {
+            let v = VertexId::new(v);
+            assert_eq!(lines.is_pinned(v), m.positions[v.idx()].z == 0.0, "{v}");
+        }
+    }
+}
