@@ -72,63 +72,55 @@ pub fn sharp_edges(mesh: &TriMesh, topo: &Topology, angle_deg: f64) -> Vec<EdgeK
     out
 }
 
-/// Split every edge of `edges` (input edges, present in `work` as they are in `reference`)
-/// into `pieces(e)` equal parts at points on the edge, splitting both faces beside it into
-/// fans. The new vertices are located on the reference face beside the edge; the new faces
-/// are unprocessed. Returns the pieces and the pinned vertices.
-pub fn split_feature_edges(
-    work: &mut WorkingMesh,
-    reference: &TriMesh,
-    edges: &[EdgeKey],
-    mut pieces: impl FnMut(EdgeKey) -> usize,
-) -> FeatureLines {
-    // Directed edge → the face that has it (the working mesh is an oriented manifold).
-    let mut directed: HashMap<(VertexId, VertexId), usize> = HashMap::new();
-    for (f, t) in work.mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            directed.insert((t[k], t[(k + 1) % 3]), f);
+/// Splits input edges of a working mesh that still has them (before the loop), keeping an
+/// oriented manifold: both faces beside an edge become fans over the new points.
+struct EdgeSplitter {
+    /// Directed edge → the working face that has it.
+    directed: HashMap<(VertexId, VertexId), usize>,
+    /// Directed input edge → the reference face that has it (the new points' location).
+    on_reference: HashMap<(VertexId, VertexId), FaceId>,
+}
+
+impl EdgeSplitter {
+    fn new(work: &WorkingMesh, reference: &TriMesh) -> EdgeSplitter {
+        let mut directed = HashMap::new();
+        for (f, t) in work.mesh.triangles.iter().enumerate() {
+            for k in 0..3 {
+                directed.insert((t[k], t[(k + 1) % 3]), f);
+            }
+        }
+        let on_reference = reference
+            .faces()
+            .flat_map(|f| {
+                let t = reference.face(f);
+                (0..3).map(move |k| ((t[k], t[(k + 1) % 3]), f))
+            })
+            .collect();
+        EdgeSplitter {
+            directed,
+            on_reference,
         }
     }
-    let on_reference: HashMap<(VertexId, VertexId), FaceId> = reference
-        .faces()
-        .flat_map(|f| {
-            let t = reference.face(f);
-            (0..3).map(move |k| ((t[k], t[(k + 1) % 3]), f))
-        })
-        .collect();
-    let mut lines = FeatureLines {
-        input_edges: edges.len(),
-        ..FeatureLines::default()
-    };
-    let mut pinned: Vec<VertexId> = Vec::new();
-    for &e in edges {
-        let (a, b) = (e.0, e.1);
-        pinned.extend([a, b]);
-        let k = pieces(e).max(1);
-        let (Some(&f1), Some(&f2)) = (directed.get(&(a, b)), directed.get(&(b, a))) else {
-            // Not an interior edge of the working mesh: keep it whole (still a feature).
-            lines.edges.insert(e);
-            continue;
-        };
-        if k == 1 {
-            lines.edges.insert(e);
-            continue;
-        }
-        // The reference face with the directed edge a→b (the working face f1 is it, or a
-        // piece of it, before the loop): the new points are located on it.
-        let Some(&loc_face) = on_reference.get(&(a, b)) else {
-            lines.edges.insert(e);
-            continue;
-        };
+
+    /// Split the input edge `a`–`b` at the parameters `params` (strictly increasing, in
+    /// (0, 1), measured from `a`). Returns the chain `a, new…, b`, or `None` when `a`–`b` is
+    /// not an interior edge of both the working mesh and the reference (nothing changes).
+    fn split(
+        &mut self,
+        work: &mut WorkingMesh,
+        reference: &TriMesh,
+        a: VertexId,
+        b: VertexId,
+        params: &[f64],
+    ) -> Option<Vec<VertexId>> {
+        let f1 = *self.directed.get(&(a, b))?;
+        let f2 = *self.directed.get(&(b, a))?;
+        let loc_face = *self.on_reference.get(&(a, b))?;
         let rt = reference.face(loc_face);
-        let slot = |v: VertexId| rt.iter().position(|&u| u == v);
-        let (Some(ia), Some(ib)) = (slot(a), slot(b)) else {
-            lines.edges.insert(e);
-            continue;
-        };
+        let ia = rt.iter().position(|&u| u == a)?;
+        let ib = rt.iter().position(|&u| u == b)?;
         let mut chain = vec![a];
-        for j in 1..k {
-            let s = j as f64 / k as f64;
+        for &s in params {
             let mut bary = [0.0; 3];
             bary[ia] = 1.0 - s;
             bary[ib] = s;
@@ -140,18 +132,14 @@ pub fn split_feature_edges(
             work.mesh.positions.push(loc.position(reference));
             work.locations.push(loc);
             chain.push(v);
-            pinned.push(v);
         }
         chain.push(b);
-        for w in chain.windows(2) {
-            lines.edges.insert(EdgeKey::new(w[0], w[1]));
-        }
         // f1 = (a, b, c) → (chain[i], chain[i+1], c); f2 = (b, a, d) → (chain[i+1], chain[i], d).
         for (f, forward) in [(f1, true), (f2, false)] {
             let t = work.mesh.triangles[f];
             let apex = t.iter().copied().find(|v| *v != a && *v != b).unwrap_or(a);
             for k in 0..3 {
-                directed.remove(&(t[k], t[(k + 1) % 3]));
+                self.directed.remove(&(t[k], t[(k + 1) % 3]));
             }
             for (i, w) in chain.windows(2).enumerate() {
                 let tri = if forward {
@@ -168,10 +156,43 @@ pub fn split_feature_edges(
                     work.mesh.triangles.len() - 1
                 };
                 for k in 0..3 {
-                    directed.insert((tri[k], tri[(k + 1) % 3]), slot);
+                    self.directed.insert((tri[k], tri[(k + 1) % 3]), slot);
                 }
             }
         }
+        Some(chain)
+    }
+}
+
+/// Split every edge of `edges` (input edges, present in `work` as they are in `reference`)
+/// into `pieces(e)` equal parts at points on the edge, splitting both faces beside it into
+/// fans. The new vertices are located on the reference face beside the edge; the new faces
+/// are unprocessed. Returns the pieces and the pinned vertices.
+pub fn split_feature_edges(
+    work: &mut WorkingMesh,
+    reference: &TriMesh,
+    edges: &[EdgeKey],
+    mut pieces: impl FnMut(EdgeKey) -> usize,
+) -> FeatureLines {
+    let mut splitter = EdgeSplitter::new(work, reference);
+    let mut lines = FeatureLines {
+        input_edges: edges.len(),
+        ..FeatureLines::default()
+    };
+    let mut pinned: Vec<VertexId> = Vec::new();
+    for &e in edges {
+        let k = pieces(e).max(1);
+        let params: Vec<f64> = (1..k).map(|j| j as f64 / k as f64).collect();
+        let chain = match params.is_empty() {
+            true => None,
+            false => splitter.split(work, reference, e.0, e.1, &params),
+        }
+        // Not split (one piece, or not an interior edge): the edge itself is the feature.
+        .unwrap_or_else(|| vec![e.0, e.1]);
+        for w in chain.windows(2) {
+            lines.edges.insert(EdgeKey::new(w[0], w[1]));
+        }
+        pinned.extend(chain);
     }
     let mut flags = vec![false; work.mesh.n_vertices()];
     for v in pinned {

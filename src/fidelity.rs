@@ -36,6 +36,11 @@ pub struct FidelityOptions {
     /// mean edge length: the input is piecewise linear, and triangles much finer than its
     /// own follow it no better (on a flat plate with sharp rims they only multiply).
     pub min_edge_ratio: f64,
+    /// Keep, per working-mesh vertex, the factor a patch's extra rounds scaled the metric by,
+    /// so a later patch over the same area (its overlap rings, a further sweep) starts from
+    /// that refinement instead of the a-priori metric. Default `false` (each patch starts
+    /// afresh); the coarse-input profile turns it on.
+    pub persist: bool,
 }
 
 impl Default for FidelityOptions {
@@ -45,6 +50,7 @@ impl Default for FidelityOptions {
             rounds: 2,
             max_factor: 16.0,
             min_edge_ratio: 0.5,
+            persist: false,
         }
     }
 }

@@ -195,6 +195,73 @@ pub struct RemeshOptions {
     /// edges of the output (no patch crosses them, no pass moves or flips them). `None`
     /// keeps none (the paper).
     pub feature_angle: Option<f64>,
+    /// Whether to run the coarse-input profile ([`RemeshOptions::coarse_profile`]): `Auto`
+    /// (default) runs it when the distance tolerance rather than the metric sets the output's
+    /// size: the a-priori fidelity scaling multiplies the expected face count
+    /// ([`expected_faces`]) by at least [`COARSE_RATIO`].
+    pub coarse_input: CoarseInput,
+}
+
+/// [`CoarseInput::Auto`] runs the coarse-input profile when the a-priori fidelity scaling
+/// multiplies the expected output face count ([`expected_faces`]) by at least this much.
+pub const COARSE_RATIO: f64 = 2.0;
+
+/// When [`remesh`] uses [`RemeshOptions::coarse_profile`] (paper-notes "Coarse inputs").
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum CoarseInput {
+    /// When the a-priori fidelity scaling multiplies [`expected_faces`] by at least
+    /// [`COARSE_RATIO`].
+    #[default]
+    Auto,
+    /// Always.
+    On,
+    /// Never (the options as given).
+    Off,
+}
+
+impl RemeshOptions {
+    /// The options for an input coarser than its output (our addition, paper-notes "Coarse
+    /// inputs"): at least 3 sweeps, because the first sweep's fixed patch boundaries are the
+    /// input's edges, longer than the output's; the fidelity control's factors kept between
+    /// patches ([`FidelityOptions::persist`]), so the further sweeps do not start again from
+    /// the a-priori metric; its refinement floor at most 0.2 of the input's mean edge (0.5 is
+    /// about the output's own edge length on such an input, where the control could not
+    /// refine at all) and at least 4 rounds per patch.
+    pub fn coarse_profile(&self) -> RemeshOptions {
+        let mut o = self.clone();
+        o.sweeps = o.sweeps.max(3);
+        o.fidelity.persist = true;
+        o.fidelity.min_edge_ratio = o.fidelity.min_edge_ratio.min(0.2);
+        o.fidelity.rounds = o.fidelity.rounds.max(4);
+        o
+    }
+}
+
+/// The number of faces an output of `reference` should have: its area in the metric (the
+/// mean of the vertex tensors `metrics[v]·scale[v]` per face; `scale` empty = 1) over the area
+/// √3/4·L_tar² of an equilateral triangle of side `l_tar`.
+pub fn expected_faces(
+    reference: &TriMesh,
+    metrics: &[Matrix3<f64>],
+    scale: &[f64],
+    l_tar: f64,
+) -> f64 {
+    let s = |v: VertexId| scale.get(v.idx()).copied().unwrap_or(1.0);
+    let area: f64 = reference
+        .faces()
+        .map(|f| {
+            let t = reference.face(f);
+            let m = t
+                .iter()
+                .map(|v| metrics[v.idx()] * s(*v))
+                .sum::<Matrix3<f64>>()
+                / 3.0;
+            let q = crate::quality::metric_sqrt(&m);
+            let [a, b, c] = reference.face_points(f);
+            0.5 * (q * (b - a)).cross(&(q * (c - a))).norm()
+        })
+        .sum();
+    area / (3f64.sqrt() / 4.0 * l_tar * l_tar)
 }
 
 impl Default for RemeshOptions {
@@ -214,6 +281,7 @@ impl Default for RemeshOptions {
             relocate: true,
             corner_defect: Some(1.0),
             feature_angle: None,
+            coarse_input: CoarseInput::Auto,
         }
     }
 }
@@ -383,6 +451,12 @@ pub struct RemeshReport {
     /// The pieces they were split into; each is certified to be an edge of the output, its
     /// vertices where the split put them.
     pub feature_pieces: usize,
+    /// [`expected_faces`] of the input at L_tar in the metric alone.
+    pub expected_faces: f64,
+    /// The same with the a-priori fidelity scaling (before any coarse-input profile).
+    pub expected_faces_fidelity: f64,
+    /// Whether the coarse-input profile ran (`options` then holds the profile's values).
+    pub coarse_input: bool,
 }
 
 /// Progress reported after every patch.
@@ -408,17 +482,21 @@ fn topology_signature(topo: &Topology) -> Vec<(Option<u32>, usize)> {
     s
 }
 
-/// Run Algorithm 1 on the metric field's reference mesh.
-///
-/// Randomness: one ChaCha8 stream seeded with `options.seed`, drawn only by the patch
-/// strategy and the planar remesher, in patch order, so the output depends on the seed only
-/// (not on thread count).
-pub fn remesh(
-    field: &MetricField,
-    stages: &Stages,
-    options: &RemeshOptions,
-    mut on_progress: impl FnMut(Progress),
-) -> Result<RemeshResult, PipelineError> {
+/// The sizes a run starts from (see [`sizing`]).
+struct Sizing {
+    l_avg: f64,
+    l_tar: f64,
+    eps: f64,
+    min_edge: f64,
+    fid_scale: Vec<f64>,
+    expected: f64,
+    expected_fidelity: f64,
+}
+
+/// L_avg, L_tar, the fidelity tolerance, the a-priori fidelity scaling and the expected output
+/// face counts without and with it, for `options` as given; errors for an empty input, a
+/// target length or a tolerance that is not a finite positive number.
+fn sizing(field: &MetricField, options: &RemeshOptions) -> Result<Sizing, PipelineError> {
     let reference = field.reference();
     if reference.n_faces() == 0 {
         return Err(PipelineError::Input("the input mesh has no faces".into()));
@@ -439,12 +517,28 @@ pub fn remesh(
             "fidelity tolerance {eps} is not a finite number ≥ 0"
         )));
     }
-    // A-priori fidelity scaling (our addition, `crate::fidelity::a_priori_scale`): the
-    // metric is scaled up isotropically where a triangle of the target size would cut off
-    // more of the reference than the tolerance allows. L_tar above is from the unscaled
-    // metric, as is every quality measure.
-    let min_edge = options.fidelity.min_edge_ratio * mean_edge_length(reference);
-    let fid_scale: Vec<f64> = if eps > 0.0 {
+    let (min_edge, fid_scale) = a_priori(field, options, l_tar);
+    Ok(Sizing {
+        l_avg,
+        l_tar,
+        eps,
+        min_edge,
+        expected: expected_faces(reference, field.vertex_metrics(), &[], l_tar),
+        expected_fidelity: expected_faces(reference, field.vertex_metrics(), &fid_scale, l_tar),
+        fid_scale,
+    })
+}
+
+/// A-priori fidelity scaling (our addition, `crate::fidelity::a_priori_scale`): the metric is
+/// scaled up isotropically where a triangle of the target size would cut off more of the
+/// reference than the tolerance allows. L_tar is from the unscaled metric, as is every
+/// quality measure. Returns the refinement floor and the factor per reference vertex (empty
+/// when the control is off).
+fn a_priori(field: &MetricField, o: &RemeshOptions, l_tar: f64) -> (f64, Vec<f64>) {
+    let reference = field.reference();
+    let min_edge = o.fidelity.min_edge_ratio * mean_edge_length(reference);
+    let eps = o.fidelity.max_deviation;
+    let fid_scale = if eps > 0.0 {
         let topo = Topology::build(reference);
         fidelity::a_priori_scale(
             reference,
@@ -456,6 +550,60 @@ pub fn remesh(
         )
     } else {
         Vec::new()
+    };
+    (min_edge, fid_scale)
+}
+
+/// The expected output face counts of a run with `options` ([`expected_faces`] at its L_tar,
+/// in the metric alone and with the a-priori fidelity scaling) and whether
+/// [`CoarseInput::Auto`] would run the coarse-input profile.
+pub fn coarse_input_estimate(
+    field: &MetricField,
+    options: &RemeshOptions,
+) -> Result<(f64, f64, bool), PipelineError> {
+    let s = sizing(field, options)?;
+    Ok((
+        s.expected,
+        s.expected_fidelity,
+        s.expected_fidelity >= COARSE_RATIO * s.expected,
+    ))
+}
+
+/// Run Algorithm 1 on the metric field's reference mesh.
+///
+/// Randomness: one ChaCha8 stream seeded with `options.seed`, drawn only by the patch
+/// strategy and the planar remesher, in patch order, so the output depends on the seed only
+/// (not on thread count).
+pub fn remesh(
+    field: &MetricField,
+    stages: &Stages,
+    options: &RemeshOptions,
+    mut on_progress: impl FnMut(Progress),
+) -> Result<RemeshResult, PipelineError> {
+    let reference = field.reference();
+    let Sizing {
+        l_avg,
+        l_tar,
+        eps,
+        mut min_edge,
+        mut fid_scale,
+        expected,
+        expected_fidelity,
+    } = sizing(field, options)?;
+    // An input where the distance tolerance, not the metric, sets the output's size runs the
+    // coarse-input profile (our addition; paper-notes "Coarse inputs").
+    let coarse = match options.coarse_input {
+        CoarseInput::On => true,
+        CoarseInput::Off => false,
+        CoarseInput::Auto => expected_fidelity >= COARSE_RATIO * expected,
+    };
+    let profile;
+    let options = if coarse {
+        profile = options.coarse_profile();
+        (min_edge, fid_scale) = a_priori(field, &profile, l_tar);
+        &profile
+    } else {
+        options
     };
     let scaled_field;
     // The metric every quality measure uses (the unscaled one).
@@ -534,6 +682,8 @@ pub fn remesh(
         .map(|v| corners.get(v).copied().unwrap_or(false) || features.is_pinned(VertexId::new(v)))
         .collect();
     let feature_edges = (!features.edges.is_empty()).then_some(&features.edges);
+    // The fidelity control's factor per working-mesh vertex (`PatchFactors`).
+    let mut vfactor: Vec<f64> = vec![1.0; work.mesh.n_vertices()];
     // Provenance of every working-mesh face, kept parallel to its triangles (`stitch` drops
     // the patch's faces in order and appends the new ones).
     let mut face_patch: Vec<Option<PatchId>> = vec![None; work.mesh.n_faces()];
@@ -548,7 +698,7 @@ pub fn remesh(
     let mut times = StageTimes::default();
     let mut cert = Certificate::default();
     let mut records = Vec::new();
-    let mut topo = if features.edges.is_empty() {
+    let mut topo = if work.mesh.n_faces() == reference.n_faces() {
         ref_topo.clone()
     } else {
         Topology::build(&work.mesh)
@@ -657,6 +807,7 @@ pub fn remesh(
                 &flip_test,
                 &ref_normals,
                 &fid_scale,
+                &vfactor,
                 min_edge,
                 embedded_input,
                 &faces,
@@ -666,7 +817,7 @@ pub fn remesh(
                 &mut cert,
             );
             match attempt {
-                Ok((replacement, distortion, fidelity_rounds)) => {
+                Ok((replacement, distortion, fidelity_rounds, factors)) => {
                     let t0 = Instant::now();
                     touched = faces
                         .iter()
@@ -682,6 +833,15 @@ pub fn remesh(
                         }
                     })?;
                     times.stitch += t0.elapsed().as_secs_f64();
+                    if options.fidelity.persist {
+                        for (v, f) in factors.existing {
+                            vfactor[v.idx()] = vfactor[v.idx()].max(f);
+                        }
+                        vfactor.extend(factors.new);
+                    } else {
+                        vfactor.resize(work.mesh.n_vertices(), 1.0);
+                    }
+                    debug_assert_eq!(vfactor.len(), work.mesh.n_vertices());
                     let mut gone = vec![false; face_patch.len()];
                     for f in &faces {
                         gone[f.idx()] = true;
@@ -954,6 +1114,9 @@ pub fn remesh(
         corners: n_corners,
         feature_edges: features.input_edges,
         feature_pieces: features.edges.len(),
+        expected_faces: expected,
+        expected_faces_fidelity: expected_fidelity,
+        coarse_input: coarse,
     };
     Ok(RemeshResult {
         mesh: work.mesh,
@@ -1052,6 +1215,7 @@ fn remesh_patch(
     flip_test: &FlipTest,
     ref_normals: &[Vector3<f64>],
     fid_scale: &[f64],
+    vfactor: &[f64],
     min_edge: f64,
     embedded_input: bool,
     faces: &[FaceId],
@@ -1059,7 +1223,7 @@ fn remesh_patch(
     rng: &mut crate::Rng,
     times: &mut StageTimes,
     cert: &mut Certificate,
-) -> Result<(Replacement, DistortionReport, usize), Failure> {
+) -> Result<(Replacement, DistortionReport, usize, PatchFactors), Failure> {
     let reference = field.reference();
     let disk =
         extract_patch(&work.mesh, faces).map_err(|e| Failure::stage("patch extraction", e))?;
@@ -1093,7 +1257,8 @@ fn remesh_patch(
         .enumerate()
         .map(|(i, g)| {
             let loc = &work.locations[g.idx()];
-            let m = field.eval_at(loc);
+            // What earlier patches' fidelity rounds needed here (1 when none).
+            let m = field.eval_at(loc) * vfactor.get(g.idx()).copied().unwrap_or(1.0).max(1.0);
             // The field already carries the interpolated a-priori factor; raise it to the
             // largest factor of the reference vertices under this vertex's faces.
             match boost.get(i) {
@@ -1145,7 +1310,7 @@ fn remesh_patch(
     };
     let mut metrics2d = metrics2d;
     let mut rounds = 0usize;
-    let replacement = loop {
+    let (replacement, patch_factors) = loop {
         let t0 = Instant::now();
         let mut planar_field =
             PlanarMetricField::new(param.uv.clone(), tris_u32.clone(), metrics2d.clone())
@@ -1189,9 +1354,51 @@ fn remesh_patch(
         .map_err(|e| Failure::stage("mapping back", e))?;
         times.lift += t0.elapsed().as_secs_f64();
 
+        // The factor by which the rounds so far scaled the metric, at every vertex of the
+        // initial mesh and (interpolated) at every new vertex, times what it carried in.
+        let factors = |metrics2d: &[nalgebra::Matrix2<f64>]| {
+            if !options.fidelity.persist {
+                return PatchFactors {
+                    existing: Vec::new(),
+                    new: Vec::new(),
+                };
+            }
+            let total: Vec<f64> = (0..metrics2d.len())
+                .map(|i| {
+                    let r = if base_trace[i] > 0.0 {
+                        metrics2d[i].trace() / base_trace[i]
+                    } else {
+                        1.0
+                    };
+                    r.max(1.0)
+                        * vfactor
+                            .get(disk.to_global[i].idx())
+                            .copied()
+                            .unwrap_or(1.0)
+                            .max(1.0)
+                })
+                .collect();
+            let new: Vec<f64> = planar
+                .points
+                .iter()
+                .zip(&planar.origin)
+                .filter(|(_, o)| o.is_none())
+                .map(|(p, _)| match planar_field.locate(p) {
+                    Some((t, b)) => (0..3)
+                        .map(|k| b[k] * total[tris_u32[t][k] as usize])
+                        .sum::<f64>()
+                        .max(1.0),
+                    None => 1.0,
+                })
+                .collect();
+            PatchFactors {
+                existing: disk.to_global.iter().copied().zip(total).collect(),
+                new,
+            }
+        };
         let eps = options.fidelity.max_deviation;
         if eps.is_nan() || eps <= 0.0 || rounds >= options.fidelity.rounds {
-            break replacement;
+            break (replacement, factors(&metrics2d));
         }
         let t0 = Instant::now();
         let mut next_new = 0usize;
@@ -1233,7 +1440,7 @@ fn remesh_patch(
         };
         times.fidelity += t0.elapsed().as_secs_f64();
         if scaled == 0 {
-            break replacement;
+            break (replacement, factors(&metrics2d));
         }
         rounds += 1;
     };
@@ -1260,7 +1467,16 @@ fn remesh_patch(
         }
         cert.locally_embedded += 1;
     }
-    Ok((replacement, param.report, rounds))
+    Ok((replacement, param.report, rounds, patch_factors))
+}
+
+/// The fidelity control's metric factors after a patch (our addition): at the patch's vertices
+/// (working-mesh ids) and at its new vertices (in [`Replacement::new_positions`] order). Kept
+/// per working-mesh vertex, so a later patch over the same area (the overlap rings, a further
+/// sweep) starts from the refinement this one needed instead of from the a-priori metric.
+struct PatchFactors {
+    existing: Vec<(VertexId, f64)>,
+    new: Vec<f64>,
 }
 
 /// Mean length of the edges of `mesh` (each interior edge counted from both faces).
@@ -2166,6 +2382,31 @@ mod tests {
         assert!(p.coords.norm() < 1e-12, "{p}");
         // A degenerate tangent metric gives no point.
         assert!(metric_optimal_point(&mesh, &fan, VertexId(0), &Matrix3::zeros()).is_none());
+    }
+
+    /// A flat unit square in the identity metric (restricted to the plane): its area over
+    /// that of an equilateral triangle of side L; a scale of 4 everywhere quadruples it.
+    #[test]
+    fn expected_faces_of_a_flat_square() {
+        let m = TriMesh {
+            positions: vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(1.0, 1.0, 0.0),
+                Point3::new(0.0, 1.0, 0.0),
+            ],
+            triangles: vec![
+                [VertexId(0), VertexId(1), VertexId(2)],
+                [VertexId(0), VertexId(2), VertexId(3)],
+            ],
+        };
+        let id = vec![Matrix3::identity(); 4];
+        let l = 0.1;
+        let want = 1.0 / (3f64.sqrt() / 4.0 * l * l);
+        let got = expected_faces(&m, &id, &[], l);
+        assert!((got - want).abs() < 1e-9 * want, "{got} vs {want}");
+        let got4 = expected_faces(&m, &id, &[4.0; 4], l);
+        assert!((got4 - 4.0 * want).abs() < 1e-9 * want, "{got4}");
     }
 
     /// The skinny pair is flipped to the short diagonal (q rises from 0.29 to 0.65) and the

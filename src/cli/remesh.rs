@@ -2,13 +2,24 @@
 
 use anyhow::{bail, Context};
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
-use conemesh::pipeline::{self, Progress, RemeshOptions, Stages};
+use conemesh::pipeline::{self, CoarseInput, Progress, RemeshOptions, Stages};
 use conemesh::quality::{EvalOptions, EvalReport, TargetLength};
 use conemesh::TriMesh;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+
+/// `--coarse`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coarse {
+    /// When the distance tolerance sets the output's size.
+    Auto,
+    /// Always.
+    On,
+    /// Never.
+    Off,
+}
 
 /// Arguments of `conemesh remesh`.
 #[derive(clap::Args, Debug)]
@@ -73,6 +84,12 @@ pub struct RemeshArgs {
     /// (the paper).
     #[arg(long, default_value_t = 0.0)]
     pub feature_angle: f64,
+    /// The coarse-input profile (3 sweeps, finer fidelity control; paper-notes "Coarse
+    /// inputs"): `auto` runs it when the distance tolerance rather than the metric sets the
+    /// output's size (the a-priori fidelity scaling at least doubles the expected face count;
+    /// the report says whether it ran), `on` always, `off` never.
+    #[arg(long, value_enum, default_value_t = Coarse::Auto)]
+    pub coarse: Coarse,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -163,6 +180,11 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         sweeps: args.sweeps,
         corner_defect: (args.corner_defect != 0.0).then_some(args.corner_defect),
         feature_angle: (args.feature_angle != 0.0).then_some(args.feature_angle),
+        coarse_input: match args.coarse {
+            Coarse::Auto => CoarseInput::Auto,
+            Coarse::On => CoarseInput::On,
+            Coarse::Off => CoarseInput::Off,
+        },
         ..RemeshOptions::default()
     };
     let total = field.reference().n_faces() as u64;
