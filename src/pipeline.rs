@@ -1134,7 +1134,8 @@ pub const MIN_PATCH_FACES: usize = 8;
 pub struct Fallbacks {
     /// Patches shrunk after a failed attempt.
     pub shrinks: usize,
-    /// Unprocessed input faces kept unchanged because even a minimal patch failed.
+    /// Unprocessed faces (of the input, or of an earlier sweep) kept unchanged because even a
+    /// minimal patch failed.
     pub kept_faces: usize,
     /// Every failed attempt: patch, size and reason.
     pub failures: Vec<String>,

@@ -255,10 +255,21 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             _ => "not checked".to_string(),
         }
     );
+    let r = &result.report;
+    if r.coarse_input {
+        println!(
+            "coarse input: the distance tolerance, not the metric, sets the size here (expected faces {:.0} in the metric, {:.0} with the fidelity scaling), so the coarse-input profile ran ({} sweeps, fidelity floor {} of the mean input edge, {} rounds, persistent factors); --coarse off for the options as given",
+            r.expected_faces,
+            r.expected_faces_fidelity,
+            r.options.sweeps,
+            r.options.fidelity.min_edge_ratio,
+            r.options.fidelity.rounds
+        );
+    }
     let fb = &result.report.fallbacks;
     if fb.kept_faces > 0 || fb.shrinks > 0 {
         eprintln!(
-            "warning: {} patch attempt(s) failed their certificates and were retried smaller; {} input face(s) could not be remeshed and were kept unchanged (details: --report, `fallbacks`)",
+            "warning: {} patch attempt(s) failed their certificates and were retried smaller; {} face(s) (of the input, or of an earlier sweep) could not be remeshed and were kept as they were (details: --report, `fallbacks`)",
             fb.failures.len(),
             fb.kept_faces
         );
