@@ -975,15 +975,18 @@ pub fn remesh(
         } else {
             FidelityOptions::default().max_deviation
         };
-        if options.edge_flips {
-            edge_flips = flip_pass(
+        let flips = |work: &mut WorkingMesh| {
+            flip_pass(
                 quality_field,
                 &flip_test,
-                &mut work,
+                work,
                 embedded_input,
                 tol,
                 feature_edges,
-            );
+            )
+        };
+        if options.edge_flips {
+            edge_flips = flips(&mut work);
         }
         if options.relocate {
             vertex_moves = smooth_pass(
@@ -994,14 +997,7 @@ pub fn remesh(
                 tol,
                 &pinned,
             );
-            edge_flips += flip_pass(
-                quality_field,
-                &flip_test,
-                &mut work,
-                embedded_input,
-                tol,
-                feature_edges,
-            );
+            edge_flips += flips(&mut work);
         }
         times.certify += t0.elapsed().as_secs_f64();
     }
