@@ -281,4 +281,76 @@ mod tests {
             assert_eq!(lines.is_pinned(v), m.positions[v.idx()].z == 0.0, "{v}");
         }
     }
+
+    /// Review: faces with two (cube) or three (tetrahedron) feature edges, each split into
+    /// 2-4 pieces: still an oriented manifold, no degenerate face, every face turned the way
+    /// of the input face it came from, `processed` parallel, every new vertex located on a
+    /// reference face that has both ends of its edge, at the right point.
+    #[test]
+    fn review_split_with_several_feature_edges_per_face() {
+        let cube = TriMesh::from_indices(
+            vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(1.0, 1.0, 0.0),
+                Point3::new(0.0, 1.0, 0.0),
+                Point3::new(0.0, 0.0, 1.0),
+                Point3::new(1.0, 0.0, 1.0),
+                Point3::new(1.0, 1.0, 1.0),
+                Point3::new(0.0, 1.0, 1.0),
+            ],
+            &[
+                [0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7],
+                [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5],
+                [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7],
+            ],
+        )
+        .expect("cube");
+        let tet = TriMesh::from_indices(
+            vec![
+                Point3::new(1.0, 1.0, 1.0),
+                Point3::new(1.0, -1.0, -1.0),
+                Point3::new(-1.0, 1.0, -1.0),
+                Point3::new(-1.0, -1.0, 1.0),
+            ],
+            &[[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
+        )
+        .expect("tet");
+        for (name, m, n_sharp) in [("cube", cube, 12), ("tet", tet, 6)] {
+            let topo = Topology::build(&m);
+            assert!(topo.is_oriented_manifold(), "{name}");
+            let sharp = sharp_edges(&m, &topo, 30.0);
+            assert_eq!(sharp.len(), n_sharp, "{name}");
+            let centre = m.positions.iter().fold(nalgebra::Vector3::zeros(), |a, p| a + p.coords)
+                / m.n_vertices() as f64;
+            let mut w = WorkingMesh::from_reference(&m);
+            let lines =
+                split_feature_edges(&mut w, &m, &sharp, |e| 2 + (e.0.idx() + e.1.idx()) % 3);
+            let expect_new: usize = sharp.iter().map(|e| 1 + (e.0.idx() + e.1.idx()) % 3).sum();
+            assert_eq!(w.mesh.n_vertices(), m.n_vertices() + expect_new, "{name}");
+            assert_eq!(w.mesh.n_faces(), m.n_faces() + 2 * expect_new, "{name}");
+            assert_eq!(w.processed.len(), w.mesh.n_faces());
+            assert_eq!(w.locations.len(), w.mesh.n_vertices());
+            assert_eq!(lines.edges.len(), n_sharp + expect_new, "{name}");
+            let t2 = Topology::build(&w.mesh);
+            assert!(t2.is_oriented_manifold(), "{name}");
+            assert_eq!(t2.euler_characteristic(), 2, "{name}");
+            assert!((w.mesh.area() - m.area()).abs() < 1e-12 * m.area(), "{name}");
+            for f in w.mesh.faces() {
+                let n = w.mesh.face_normal_raw(f);
+                assert!(n.norm() > 1e-9, "{name}: {f} degenerate");
+                assert!(n.dot(&(w.mesh.face_centroid(f).coords - centre)) > 0.0, "{name}: {f}");
+            }
+            for v in m.n_vertices()..w.mesh.n_vertices() {
+                let loc = w.locations[v];
+                assert_eq!(loc.position(&m), w.mesh.positions[v], "{name}");
+                let on: Vec<usize> = (0..3).filter(|&k| loc.bary[k] != 0.0).collect();
+                assert_eq!(on.len(), 2, "{name}: v{v} not on an edge of its face");
+                let rt = m.face(loc.face);
+                let key = EdgeKey::new(rt[on[0]], rt[on[1]]);
+                assert!(sharp.contains(&key), "{name}: v{v} on a non-feature edge");
+                assert!(lines.is_pinned(VertexId::new(v)));
+            }
+        }
+    }
 }
