@@ -21,6 +21,10 @@ use crate::stitch::WorkingMesh;
 use nalgebra::Point3;
 use std::collections::{HashMap, HashSet};
 
+/// Most vertices a feature split may add (a target far below the feature edges' length
+/// would otherwise ask for an unbounded allocation).
+pub const MAX_NEW_VERTICES: usize = 10_000_000;
+
 /// The feature lines of a working mesh after [`split_feature_edges`].
 #[derive(Clone, Debug, Default)]
 pub struct FeatureLines {
@@ -164,15 +168,15 @@ impl EdgeSplitter {
     }
 }
 
-/// Split every edge of `edges` (input edges, present in `work` as they are in `reference`)
-/// into `pieces(e)` equal parts at points on the edge, splitting both faces beside it into
-/// fans. The new vertices are located on the reference face beside the edge; the new faces
-/// are unprocessed. Returns the pieces and the pinned vertices.
+/// Split every edge `e` of `edges` (input edges, present in `work` as they are in
+/// `reference`) into `k` equal parts (`(e, k)`, `k ≥ 1`) at points on the edge, splitting both
+/// faces beside it into fans. The new vertices are located on the reference face beside the
+/// edge; the new faces are unprocessed. Returns the pieces and the pinned vertices. The caller
+/// bounds the counts (the pipeline refuses a split beyond [`MAX_NEW_VERTICES`]).
 pub fn split_feature_edges(
     work: &mut WorkingMesh,
     reference: &TriMesh,
-    edges: &[EdgeKey],
-    mut pieces: impl FnMut(EdgeKey) -> usize,
+    edges: &[(EdgeKey, usize)],
 ) -> FeatureLines {
     let mut splitter = EdgeSplitter::new(work, reference);
     let mut lines = FeatureLines {
@@ -180,8 +184,8 @@ pub fn split_feature_edges(
         ..FeatureLines::default()
     };
     let mut pinned: Vec<VertexId> = Vec::new();
-    for &e in edges {
-        let k = pieces(e).max(1);
+    for &(e, k) in edges {
+        let k = k.max(1);
         let params: Vec<f64> = (1..k).map(|j| j as f64 / k as f64).collect();
         let chain = match params.is_empty() {
             true => None,
@@ -248,7 +252,8 @@ mod tests {
         let topo = Topology::build(&m);
         let eq = sharp_edges(&m, &topo, 60.0);
         let mut w = WorkingMesh::from_reference(&m);
-        let lines = split_feature_edges(&mut w, &m, &eq, |e| 1 + e.0.idx() % 3);
+        let with_k: Vec<(EdgeKey, usize)> = eq.iter().map(|e| (*e, 1 + e.0.idx() % 3)).collect();
+        let lines = split_feature_edges(&mut w, &m, &with_k);
         let expect_new: usize = eq.iter().map(|e| e.0.idx() % 3).sum();
         assert_eq!(w.mesh.n_vertices(), m.n_vertices() + expect_new);
         assert_eq!(w.mesh.n_faces(), m.n_faces() + 2 * expect_new);
@@ -282,12 +287,12 @@ mod tests {
         }
     }
 
-    /// Review: faces with two (cube) or three (tetrahedron) feature edges, each split into
+    /// Faces with two (cube) or three (tetrahedron) feature edges, each split into
     /// 2-4 pieces: still an oriented manifold, no degenerate face, every face turned the way
     /// of the input face it came from, `processed` parallel, every new vertex located on a
     /// reference face that has both ends of its edge, at the right point.
     #[test]
-    fn review_split_with_several_feature_edges_per_face() {
+    fn split_with_several_feature_edges_per_face() {
         let cube = TriMesh::from_indices(
             vec![
                 Point3::new(0.0, 0.0, 0.0),
@@ -300,9 +305,18 @@ mod tests {
                 Point3::new(0.0, 1.0, 1.0),
             ],
             &[
-                [0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7],
-                [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5],
-                [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7],
+                [0, 2, 1],
+                [0, 3, 2],
+                [4, 5, 6],
+                [4, 6, 7],
+                [0, 1, 5],
+                [0, 5, 4],
+                [1, 2, 6],
+                [1, 6, 5],
+                [2, 3, 7],
+                [2, 7, 6],
+                [3, 0, 4],
+                [3, 4, 7],
             ],
         )
         .expect("cube");
@@ -321,11 +335,17 @@ mod tests {
             assert!(topo.is_oriented_manifold(), "{name}");
             let sharp = sharp_edges(&m, &topo, 30.0);
             assert_eq!(sharp.len(), n_sharp, "{name}");
-            let centre = m.positions.iter().fold(nalgebra::Vector3::zeros(), |a, p| a + p.coords)
+            let centre = m
+                .positions
+                .iter()
+                .fold(nalgebra::Vector3::zeros(), |a, p| a + p.coords)
                 / m.n_vertices() as f64;
             let mut w = WorkingMesh::from_reference(&m);
-            let lines =
-                split_feature_edges(&mut w, &m, &sharp, |e| 2 + (e.0.idx() + e.1.idx()) % 3);
+            let with_k: Vec<(EdgeKey, usize)> = sharp
+                .iter()
+                .map(|e| (*e, 2 + (e.0.idx() + e.1.idx()) % 3))
+                .collect();
+            let lines = split_feature_edges(&mut w, &m, &with_k);
             let expect_new: usize = sharp.iter().map(|e| 1 + (e.0.idx() + e.1.idx()) % 3).sum();
             assert_eq!(w.mesh.n_vertices(), m.n_vertices() + expect_new, "{name}");
             assert_eq!(w.mesh.n_faces(), m.n_faces() + 2 * expect_new, "{name}");
@@ -335,11 +355,17 @@ mod tests {
             let t2 = Topology::build(&w.mesh);
             assert!(t2.is_oriented_manifold(), "{name}");
             assert_eq!(t2.euler_characteristic(), 2, "{name}");
-            assert!((w.mesh.area() - m.area()).abs() < 1e-12 * m.area(), "{name}");
+            assert!(
+                (w.mesh.area() - m.area()).abs() < 1e-12 * m.area(),
+                "{name}"
+            );
             for f in w.mesh.faces() {
                 let n = w.mesh.face_normal_raw(f);
                 assert!(n.norm() > 1e-9, "{name}: {f} degenerate");
-                assert!(n.dot(&(w.mesh.face_centroid(f).coords - centre)) > 0.0, "{name}: {f}");
+                assert!(
+                    n.dot(&(w.mesh.face_centroid(f).coords - centre)) > 0.0,
+                    "{name}: {f}"
+                );
             }
             for v in m.n_vertices()..w.mesh.n_vertices() {
                 let loc = w.locations[v];

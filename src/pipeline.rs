@@ -668,13 +668,31 @@ pub fn remesh(
     let features = match sharp.is_empty() {
         true => crate::features::FeatureLines::default(),
         false => {
+            // Pieces of about L_tar in the metric the planar remesher sees (the scaled one).
             let m = field.vertex_metrics();
-            crate::features::split_feature_edges(&mut work, reference, &sharp, |e| {
-                let d = reference.positions[e.1.idx()] - reference.positions[e.0.idx()];
-                let mm = (m[e.0.idx()] + m[e.1.idx()]) * 0.5;
-                let len = d.dot(&(mm * d)).max(0.0).sqrt();
-                (len / l_tar).round().max(1.0) as usize
-            })
+            let counts: Vec<f64> = sharp
+                .iter()
+                .map(|e| {
+                    let d = reference.positions[e.1.idx()] - reference.positions[e.0.idx()];
+                    let mm = (m[e.0.idx()] + m[e.1.idx()]) * 0.5;
+                    (d.dot(&(mm * d)).max(0.0).sqrt() / l_tar).round().max(1.0)
+                })
+                .collect();
+            let new_vertices: f64 = counts.iter().map(|k| k - 1.0).sum();
+            if !(new_vertices <= crate::features::MAX_NEW_VERTICES as f64) {
+                return Err(PipelineError::Input(format!(
+                    "feature lines would need {new_vertices:.3e} new vertices at L_tar = {l_tar:e} \
+                     (more than {}): the target length is too small for the input's {} feature edges",
+                    crate::features::MAX_NEW_VERTICES,
+                    sharp.len()
+                )));
+            }
+            let with_k: Vec<_> = sharp
+                .iter()
+                .zip(&counts)
+                .map(|(e, k)| (*e, *k as usize))
+                .collect();
+            crate::features::split_feature_edges(&mut work, reference, &with_k)
         }
     };
     // Vertices no pass may move: corners and feature-line vertices.
@@ -841,7 +859,18 @@ pub fn remesh(
                     } else {
                         vfactor.resize(work.mesh.n_vertices(), 1.0);
                     }
-                    debug_assert_eq!(vfactor.len(), work.mesh.n_vertices());
+                    if vfactor.len() != work.mesh.n_vertices() {
+                        return Err(PipelineError::Stage {
+                            patch: pid,
+                            seed,
+                            stage: "fidelity factors",
+                            message: format!(
+                                "{} factors for {} vertices after stitching",
+                                vfactor.len(),
+                                work.mesh.n_vertices()
+                            ),
+                        });
+                    }
                     let mut gone = vec![false; face_patch.len()];
                     for f in &faces {
                         gone[f.idx()] = true;
@@ -1874,9 +1903,6 @@ fn interior_corner(
     inside.first().copied()
 }
 
-/// A smaller disk inside `faces`: grown face by face (breadth first, exact disk rule) from
-/// `seed_face` if it is unprocessed, else from the first unprocessed face, up to `target`
-/// faces. Deterministic.
 /// A feature edge shared by two faces of the patch (so inside it), the smallest if several.
 fn interior_feature(
     mesh: &TriMesh,
@@ -1897,6 +1923,9 @@ fn interior_feature(
         .min()
 }
 
+/// A smaller disk inside `faces`: grown face by face (breadth first, exact disk rule) from
+/// `seed_face` if it is unprocessed, else from the first unprocessed face, up to `target`
+/// faces. Deterministic.
 fn shrink_patch(
     work: &WorkingMesh,
     topo: &Topology,

@@ -219,3 +219,24 @@ fn a_strategy_that_crosses_a_feature_line_is_stopped_by_name() {
         other => panic!("expected FeatureInterior, got {:?}", other.map(|_| ())),
     }
 }
+
+/// A target far below the feature edges' length would ask for ~1e19 feature vertices: an
+/// input error naming the cause, not a panic or an unbounded allocation.
+#[test]
+fn a_tiny_target_with_feature_lines_is_an_input_error() {
+    let f = field(&lens());
+    let o = RemeshOptions {
+        feature_angle: Some(60.0),
+        target: conemesh::quality::TargetLength::Absolute(1e-20),
+        ..RemeshOptions::default()
+    };
+    match remesh(&f, &Stages::default(), &o, |_| {}) {
+        Err(PipelineError::Input(msg)) => {
+            assert!(
+                msg.contains("feature lines would need") && msg.contains("too small"),
+                "{msg}"
+            )
+        }
+        other => panic!("expected an input error, got {:?}", other.map(|_| ())),
+    }
+}

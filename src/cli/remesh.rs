@@ -257,13 +257,17 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     );
     let r = &result.report;
     if r.coarse_input {
+        let why = if r.options.coarse_input == CoarseInput::On {
+            "forced by --coarse on".to_string()
+        } else {
+            format!(
+                "the distance tolerance, not the metric, sets the size here: expected faces {:.0} in the metric, {:.0} with the fidelity scaling; --coarse off for the options as given",
+                r.expected_faces, r.expected_faces_fidelity
+            )
+        };
         println!(
-            "coarse input: the distance tolerance, not the metric, sets the size here (expected faces {:.0} in the metric, {:.0} with the fidelity scaling), so the coarse-input profile ran ({} sweeps, fidelity floor {} of the mean input edge, {} rounds, persistent factors); --coarse off for the options as given",
-            r.expected_faces,
-            r.expected_faces_fidelity,
-            r.options.sweeps,
-            r.options.fidelity.min_edge_ratio,
-            r.options.fidelity.rounds
+            "coarse-input profile ran ({} sweeps, fidelity floor {} of the mean input edge, {} rounds, persistent factors): {why}",
+            r.options.sweeps, r.options.fidelity.min_edge_ratio, r.options.fidelity.rounds
         );
     }
     let fb = &result.report.fallbacks;
