@@ -679,7 +679,7 @@ pub fn remesh(
                 })
                 .collect();
             let new_vertices: f64 = counts.iter().map(|k| k - 1.0).sum();
-            if !(new_vertices <= crate::features::MAX_NEW_VERTICES as f64) {
+            if new_vertices.is_nan() || new_vertices > crate::features::MAX_NEW_VERTICES as f64 {
                 return Err(PipelineError::Input(format!(
                     "feature lines would need {new_vertices:.3e} new vertices at L_tar = {l_tar:e} \
                      (more than {}): the target length is too small for the input's {} feature edges",
