@@ -1074,16 +1074,11 @@ pub fn remesh(
     }
     // Every feature-line piece is still an edge of the working mesh, its vertices unmoved.
     if !features.edges.is_empty() {
-        let edges: HashSet<EdgeKey> = work
-            .mesh
-            .triangles
-            .iter()
-            .flat_map(|t| (0..3).map(move |k| EdgeKey::new(t[k], t[(k + 1) % 3])))
-            .collect();
+        let edges = crate::quality::unique_edges(&work.mesh);
         let mut pieces: Vec<EdgeKey> = features.edges.iter().copied().collect();
         pieces.sort_unstable();
         if let Some(e) = pieces.into_iter().find(|e| {
-            !edges.contains(e)
+            edges.binary_search(e).is_err()
                 || [e.0, e.1]
                     .iter()
                     .any(|v| features.positions.get(v) != work.mesh.positions.get(v.idx()))
