@@ -517,17 +517,29 @@ fn sizing(field: &MetricField, options: &RemeshOptions) -> Result<Sizing, Pipeli
             "fidelity tolerance {eps} is not a finite number ≥ 0"
         )));
     }
+    let expected = expected_faces(reference, field.vertex_metrics(), &[], l_tar);
+    // A target far below the input's size would run for hours and exhaust memory: refuse it
+    // up front, naming the count.
+    if expected.is_nan() || expected > MAX_EXPECTED_FACES {
+        return Err(PipelineError::Input(format!(
+            "target edge length {l_tar:e} is too small for this input: the output would have about \
+             {expected:.3e} faces (more than {MAX_EXPECTED_FACES:e})"
+        )));
+    }
     let (min_edge, fid_scale) = a_priori(field, options, l_tar);
     Ok(Sizing {
         l_avg,
         l_tar,
         eps,
         min_edge,
-        expected: expected_faces(reference, field.vertex_metrics(), &[], l_tar),
+        expected,
         expected_fidelity: expected_faces(reference, field.vertex_metrics(), &fid_scale, l_tar),
         fid_scale,
     })
 }
+
+/// Largest expected output ([`expected_faces`] in the metric at L_tar) a run accepts.
+pub const MAX_EXPECTED_FACES: f64 = 1e8;
 
 /// A-priori fidelity scaling (our addition, `crate::fidelity::a_priori_scale`): the metric is
 /// scaled up isotropically where a triangle of the target size would cut off more of the

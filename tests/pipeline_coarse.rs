@@ -151,3 +151,23 @@ fn off_gives_the_knight_the_paper_settings() {
     let q = conemesh::quality::quality_stats(&r.mesh, &metrics);
     assert!(q.q_avg < 0.85, "q_avg {}", q.q_avg);
 }
+
+/// A target far below the input's size (here ~1e38 expected faces) is refused up front as an
+/// input error naming the count, instead of running until memory runs out.
+#[test]
+fn a_target_too_small_for_the_input_is_refused_up_front() {
+    let f = unit_field(&generators::torus(1.0, 0.4, 24, 10));
+    let o = RemeshOptions {
+        target: conemesh::quality::TargetLength::Absolute(1e-20),
+        ..RemeshOptions::default()
+    };
+    match remesh(&f, &Stages::default(), &o, |_| {}) {
+        Err(conemesh::pipeline::PipelineError::Input(msg)) => {
+            assert!(msg.contains("too small") && msg.contains("faces"), "{msg}")
+        }
+        other => panic!("expected an input error, got {:?}", other.map(|_| ())),
+    }
+    assert!(coarse_input_estimate(&f, &o).is_err());
+    // The ordinary target is accepted.
+    assert!(coarse_input_estimate(&f, &RemeshOptions::default()).is_ok());
+}
