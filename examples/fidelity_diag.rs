@@ -3,7 +3,7 @@
 //! input there. `cargo run --release --example fidelity_diag -- INPUT OUTPUT [N]`.
 
 use conemesh::metric::{principal_curvatures, CurvatureOptions, Normalization};
-use conemesh::quality::SurfaceProjector;
+use conemesh::mesh::SurfaceProjector;
 use conemesh::{FaceId, TriMesh};
 use nalgebra::Point3;
 

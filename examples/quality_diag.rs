@@ -6,7 +6,8 @@
 
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
 use conemesh::pipeline::{remesh, RemeshOptions, Stages};
-use conemesh::quality::{face_qualities, SurfaceProjector};
+use conemesh::mesh::SurfaceProjector;
+use conemesh::quality::face_qualities;
 use conemesh::{EdgeKey, FaceId, TriMesh};
 use nalgebra::Point3;
 use std::collections::HashMap;

@@ -85,7 +85,10 @@ proptest! {
             if let Some(c) = p.max_growth_cost { prop_assert!(c < 0.1); }
         }
         prop_assert!(covered.iter().all(|&c| c));
-        prop_assert!(a.patch_of_face.iter().all(|p| p.idx() < a.patches.len()));
+        prop_assert!(a
+            .patch_of_face
+            .iter()
+            .all(|p| p.is_some_and(|p| p.idx() < a.patches.len())));
         let b = run(seed);
         prop_assert_eq!(a, b);
     }

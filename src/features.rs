@@ -207,6 +207,67 @@ pub fn split_feature_edges(
     lines
 }
 
+/// Errors of the feature split.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FeatureError {
+    /// The target length is so small that the split would add more than
+    /// [`MAX_NEW_VERTICES`] vertices.
+    #[error(
+        "feature lines would need {new_vertices:.3e} new vertices at L_tar = {l_tar:e} (more than \
+         {MAX_NEW_VERTICES}): the target length is too small for the input's {edges} feature edges"
+    )]
+    TooManyVertices {
+        /// vertices the split would add
+        new_vertices: f64,
+        /// the target length
+        l_tar: f64,
+        /// feature edges of the input
+        edges: usize,
+    },
+}
+
+/// The feature lines of Algorithm 1's working mesh (before the loop): the input edges sharper
+/// than `angle_deg` (`None`: no feature lines), each split into pieces of about `l_tar` in
+/// `metrics` (the metric the planar remesher sees, one tensor per reference vertex).
+pub fn split_to_target(
+    work: &mut WorkingMesh,
+    reference: &TriMesh,
+    topo: &Topology,
+    angle_deg: Option<f64>,
+    metrics: &[nalgebra::Matrix3<f64>],
+    l_tar: f64,
+) -> Result<FeatureLines, FeatureError> {
+    let sharp = match angle_deg {
+        Some(a) => sharp_edges(reference, topo, a),
+        None => Vec::new(),
+    };
+    if sharp.is_empty() {
+        return Ok(FeatureLines::default());
+    }
+    let counts: Vec<f64> = sharp
+        .iter()
+        .map(|e| {
+            let d = reference.positions[e.1.idx()] - reference.positions[e.0.idx()];
+            let mm = (metrics[e.0.idx()] + metrics[e.1.idx()]) * 0.5;
+            (d.dot(&(mm * d)).max(0.0).sqrt() / l_tar).round().max(1.0)
+        })
+        .collect();
+    let new_vertices: f64 = counts.iter().map(|k| k - 1.0).sum();
+    if new_vertices.is_nan() || new_vertices > MAX_NEW_VERTICES as f64 {
+        return Err(FeatureError::TooManyVertices {
+            new_vertices,
+            l_tar,
+            edges: sharp.len(),
+        });
+    }
+    let with_k: Vec<_> = sharp
+        .iter()
+        .zip(&counts)
+        .map(|(e, k)| (*e, *k as usize))
+        .collect();
+    Ok(split_feature_edges(work, reference, &with_k))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,10 +12,12 @@
 //! - [`quality`], [`report`]: Sec. 4.1, the yardstick.
 
 pub mod check;
+pub mod contract;
 pub mod error;
 pub mod features;
 pub mod fidelity;
 pub mod ids;
+pub mod improve;
 pub mod invariants;
 pub mod io;
 pub mod lift;
@@ -26,6 +28,7 @@ pub mod patches;
 pub mod pipeline;
 pub mod predicates;
 pub mod quality;
+pub mod registry;
 pub mod remesh2d;
 pub mod report;
 pub mod stitch;

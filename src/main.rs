@@ -31,6 +31,8 @@ enum Command {
     Param(cli::param::ParamArgs),
     /// Remesh a surface anisotropically (Algorithm 1).
     Remesh(cli::remesh::RemeshArgs),
+    /// List the registered patch strategies, parameterizers and planar remeshers.
+    Stages(cli::stages::StagesArgs),
 }
 
 fn main() -> ExitCode {
@@ -43,6 +45,7 @@ fn main() -> ExitCode {
         Command::Patches(a) => cli::patches::run(a),
         Command::Param(a) => cli::param::run(a),
         Command::Remesh(a) => cli::remesh::run(a),
+        Command::Stages(a) => cli::stages::run(a),
     };
     match result {
         Ok(code) => code,

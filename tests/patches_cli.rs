@@ -36,5 +36,5 @@ fn patches_command_writes_ply_and_json() {
         .output()
         .expect("run conemesh");
     assert!(!bad.status.success());
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown strategy `nope`"));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown patch strategy `nope`"));
 }

@@ -4,7 +4,7 @@
 use conemesh::mesh::generators;
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
 use conemesh::patches::{ConePatches, Patch, PatchContext, PatchError, PatchStrategy};
-use conemesh::pipeline::{remesh, RemeshOptions, RemeshResult, Stages};
+use conemesh::pipeline::{remesh, RemeshOptions, RemeshResult, Stage, Stages};
 use conemesh::{Topology, TriMesh};
 use rand_chacha::ChaCha8Rng;
 use std::sync::{Arc, Mutex};
@@ -35,27 +35,22 @@ fn run(mesh: &TriMesh, seed: u64) -> (MetricField, RemeshResult) {
     (field, result)
 }
 
-/// How many failed attempts (from `report.fallbacks.failures`, formatted
-/// `"{patch} ({n} faces): {stage}: {message}"`) got past each certificate before failing.
-/// An attempt runs, in order: certify_disk, parameterization (+ certify_bijective), metric
-/// transfer, planar remeshing (+ certify_planar), mapping back, lifted-face certificates.
+/// How many failed attempts (the typed records of `report.fallbacks.failures`) got past each
+/// certificate before failing. An attempt runs, in order: certify_disk, parameterization
+/// (+ certify_bijective), metric transfer, planar remeshing (+ certify_planar), mapping back,
+/// lifted-face certificates.
 fn failures_past(r: &RemeshResult) -> (usize, usize) {
-    let stage_of = |f: &str| {
-        f.split_once("): ")
-            .map(|(_, rest)| rest.split(':').next().unwrap_or("").to_string())
-            .unwrap_or_default()
-    };
     let mut past_param = 0;
     let mut past_planar = 0;
     for f in &r.report.fallbacks.failures {
-        match stage_of(f).as_str() {
-            "patch extraction" | "parameterization" => {}
-            "metric transfer" | "planar remeshing" => past_param += 1,
-            "mapping back" | "lifted faces" => {
+        match f.stage {
+            Stage::PatchExtraction | Stage::Parameterization => {}
+            Stage::MetricTransfer | Stage::PlanarRemeshing => past_param += 1,
+            Stage::MappingBack | Stage::LiftedFaces => {
                 past_param += 1;
                 past_planar += 1;
             }
-            other => panic!("unknown failure stage `{other}` in `{f}`"),
+            other => panic!("a failed attempt cannot stop at `{other}`: {f}"),
         }
     }
     (past_param, past_planar)

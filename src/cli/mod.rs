@@ -7,3 +7,4 @@ pub mod eval;
 pub mod param;
 pub mod patches;
 pub mod remesh;
+pub mod stages;

@@ -1,9 +1,11 @@
-//! `conemesh patches [MESH] [--seed N] [--strategy cone|kring] [-o OUT.ply] [--json R.json]`:
+//! `conemesh patches [MESH] [--seed N] [--strategy NAME] [-o OUT.ply] [--json R.json]`:
 //! cover a mesh with certified disk patches (Sec. 3.2, no remeshing) and report them.
 
 use conemesh::io::{read_mesh, write_mesh_with, MeshAttributes, WriteOptions};
-use conemesh::mesh::{generators, TriMesh};
-use conemesh::patches::{cover, strategy_by_name, CoverOptions, STRATEGY_NAMES};
+use conemesh::mesh::generators;
+use conemesh::metric::Normalization;
+use conemesh::patches::{cover, CoverOptions};
+use conemesh::registry::Params;
 use rand::SeedableRng;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -17,31 +19,18 @@ pub struct PatchesArgs {
     /// Seed of the random number generator (seed vertices).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Patch strategy: `cone` (the paper, default) or `kring` (geodesic k-ring disks).
+    /// Patch strategy, by registry name (`conemesh stages` lists them).
     #[arg(long, default_value = "cone")]
     pub strategy: String,
+    /// An option of the patch strategy, `KEY=VALUE` (repeatable).
+    #[arg(long, value_name = "KEY=VALUE")]
+    pub strategy_opt: Vec<String>,
     /// Write the mesh with a per-face `patch` property and colour (PLY recommended).
     #[arg(short = 'o', long)]
     pub output: Option<PathBuf>,
     /// Write per-patch statistics as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,
-}
-
-/// The mesh scaled about its bounding-box centre to bounding-box diagonal 1 (the pipeline's
-/// working units, Sec. 3.1 notes).
-fn normalized(mesh: &TriMesh) -> TriMesh {
-    let mut m = mesh.clone();
-    if let Some((lo, hi)) = mesh.bbox() {
-        let d = (hi - lo).norm();
-        let c = nalgebra::center(&lo, &hi);
-        if d > 0.0 {
-            for p in &mut m.positions {
-                *p = nalgebra::Point3::from((*p - c) / d);
-            }
-        }
-    }
-    m
 }
 
 /// A distinct colour per patch (golden-ratio hue walk).
@@ -74,14 +63,9 @@ pub fn run(args: PatchesArgs) -> anyhow::Result<ExitCode> {
         }
         None => (generators::default_surface(), "built-in torus".to_string()),
     };
-    let Some(strategy) = strategy_by_name(&args.strategy) else {
-        anyhow::bail!(
-            "unknown strategy `{}` (available: {})",
-            args.strategy,
-            STRATEGY_NAMES.join(", ")
-        );
-    };
-    let work = normalized(&mesh);
+    let strategy = conemesh::patches::strategy(&args.strategy, Params::parse(&args.strategy_opt)?)?;
+    // The pipeline's working units (bounding-box diagonal 1).
+    let work = Normalization::of(&mesh).apply(&mesh);
     let mut rng = conemesh::Rng::seed_from_u64(args.seed);
     let t0 = Instant::now();
     let run = cover(&work, strategy.as_ref(), &CoverOptions::default(), &mut rng)?;
@@ -104,10 +88,20 @@ pub fn run(args: PatchesArgs) -> anyhow::Result<ExitCode> {
         secs
     );
     if let Some(out) = &args.output {
-        let ids: Vec<i64> = run.patch_of_face.iter().map(|p| p.0 as i64).collect();
+        // -1: a face no patch covered (only when the patch budget ran out).
+        let ids: Vec<i64> = run
+            .patch_of_face
+            .iter()
+            .map(|p| p.map_or(-1, |p| p.0 as i64))
+            .collect();
         let attrs = MeshAttributes {
             face_ints: vec![("patch".to_string(), ids)],
-            face_colors: Some(run.patch_of_face.iter().map(|p| colour(p.idx())).collect()),
+            face_colors: Some(
+                run.patch_of_face
+                    .iter()
+                    .map(|p| p.map_or([128, 128, 128], |p| colour(p.idx())))
+                    .collect(),
+            ),
             ..Default::default()
         };
         write_mesh_with(out, &mesh, &attrs, &WriteOptions::default())

@@ -1,10 +1,9 @@
 //! `conemesh remesh`: Algorithm 1 end to end, with the report and the Table-1 row.
 
-use anyhow::{bail, Context};
-use conemesh::metric::{MetricField, MetricOptions, Normalization};
-use conemesh::pipeline::{self, CoarseInput, Progress, RemeshOptions, Stages};
+use anyhow::Context;
+use conemesh::pipeline::{CoarseInput, Progress, RemeshOptions, Remesher, Stages};
 use conemesh::quality::{EvalOptions, EvalReport, TargetLength};
-use conemesh::TriMesh;
+use conemesh::registry::Params;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -42,15 +41,34 @@ pub struct RemeshArgs {
     /// Seed of the run's one RNG.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Patch strategy: `cone` (the paper) or `kring`.
+    /// Patch strategy (Sec. 3.2), by registry name (`conemesh stages` lists them).
     #[arg(long, default_value = "cone")]
     pub strategy: String,
-    /// Cone patches: rings of already-remeshed faces each patch expands into (Sec. 4.2).
+    /// An option of the patch strategy, `KEY=VALUE` (repeatable).
+    #[arg(long, value_name = "KEY=VALUE")]
+    pub strategy_opt: Vec<String>,
+    /// Parameterizer (Sec. 3.3), by registry name.
+    #[arg(long, default_value = "sd")]
+    pub param: String,
+    /// An option of the parameterizer, `KEY=VALUE` (repeatable).
+    #[arg(long, value_name = "KEY=VALUE")]
+    pub param_opt: Vec<String>,
+    /// Planar remesher (Sec. 3.3), by registry name.
+    #[arg(long, default_value = "lct")]
+    pub remesher: String,
+    /// An option of the planar remesher, `KEY=VALUE` (repeatable).
+    #[arg(long, value_name = "KEY=VALUE")]
+    pub remesher_opt: Vec<String>,
+    /// Rings of already-remeshed faces each patch expands into (Sec. 4.2); the same as
+    /// `--strategy-opt expand_rings=R`.
     #[arg(long)]
     pub expand_rings: Option<usize>,
-    /// Cone patches: largest patch, in faces (no limit by default, as in the paper).
+    /// Largest patch grown, in faces; the same as `--strategy-opt max_faces=N`.
     #[arg(long)]
     pub max_patch_faces: Option<usize>,
+    /// Stop after this many patches; the faces not reached are kept as they were (reported).
+    #[arg(long)]
+    pub max_patches: Option<usize>,
     /// Write the full report (options, certificates, per-stage times, quality) as JSON.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -98,7 +116,7 @@ pub struct RemeshArgs {
 /// Run `conemesh remesh`.
 pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     let t_start = Instant::now();
-    let (name, file_mesh) = match &args.mesh {
+    let (name, mesh) = match &args.mesh {
         Some(p) => {
             let loaded =
                 conemesh::io::read_mesh(p).with_context(|| format!("reading {}", p.display()))?;
@@ -116,136 +134,46 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "torus".into());
     // A user metric has one tensor per vertex of the file, in file order.
-    let file_metric = match &args.metric {
+    let metric = match &args.metric {
         Some(p) => Some(
-            conemesh::io::sol::read_sol(p, file_mesh.n_vertices())
+            conemesh::io::sol::read_sol(p, mesh.n_vertices())
                 .with_context(|| format!("reading metric {}", p.display()))?,
         ),
         None => None,
     };
-    // Unreferenced vertices carry no surface; drop them. The compaction keeps the order of the
-    // other vertices, and the user metric follows them through the map.
-    let (file_mesh, map) = file_mesh.without_unreferenced_vertices();
-    let user_metric = file_metric.map(|m| {
-        let mut kept = vec![nalgebra::Matrix3::zeros(); file_mesh.n_vertices()];
-        for (old, new) in map.iter().enumerate() {
-            if let Some(n) = new {
-                kept[n.idx()] = m[old];
-            }
-        }
-        kept
-    });
-    let norm = Normalization::of(&file_mesh);
-    let reference = norm.apply(&file_mesh);
-    let field = match &user_metric {
-        Some(m) => MetricField::new(
-            reference,
-            m.iter().map(|m| norm.metric_to_unit(m)).collect(),
-        )?,
-        None => MetricField::from_curvature(reference, &MetricOptions::default())?,
-    };
-    let patches: Box<dyn conemesh::patches::PatchStrategy> = if args.strategy == "cone" {
-        let mut o = conemesh::patches::ConeOptions::default();
-        if let Some(r) = args.expand_rings {
-            o.expand_rings = r;
-        }
-        o.max_faces = args.max_patch_faces.or(o.max_faces);
-        Box::new(conemesh::patches::ConePatches { options: o })
-    } else {
-        strategy(&args.strategy)?
-    };
-    let stages = Stages {
-        patches,
-        ..Stages::default()
-    };
-    let options = RemeshOptions {
-        seed: args.seed,
-        // A metric length is the same in file units and in unit space (Normalization).
-        target: match args.ltar {
-            Some(l) => TargetLength::Absolute(l),
-            None => TargetLength::Factor(args.ltar_factor),
-        },
-        check_self_intersections: !args.no_self_intersections,
-        fidelity: conemesh::fidelity::FidelityOptions {
-            max_deviation: args.hausd,
-            ..Default::default()
-        },
-        debug_dir: Some(args.debug_dir.clone().unwrap_or_else(|| {
-            args.output
-                .parent()
-                .filter(|p| !p.as_os_str().is_empty())
-                .map(PathBuf::from)
-                .unwrap_or_else(|| PathBuf::from("."))
-        })),
-        sweeps: args.sweeps,
-        corner_defect: (args.corner_defect != 0.0).then_some(args.corner_defect),
-        feature_angle: (args.feature_angle != 0.0).then_some(args.feature_angle),
-        coarse_input: match args.coarse {
-            Coarse::Auto => CoarseInput::Auto,
-            Coarse::On => CoarseInput::On,
-            Coarse::Off => CoarseInput::Off,
-        },
-        ..RemeshOptions::default()
-    };
-    let total = field.reference().n_faces() as u64;
-    let bar = if args.quiet {
-        ProgressBar::hidden()
-    } else {
-        let b = ProgressBar::new(total);
-        // A constant template; should it ever be refused, keep indicatif's default style.
-        if let Ok(style) = ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} input faces covered, {msg}",
-        ) {
-            b.set_style(style.progress_chars("=> "));
-        }
-        b
-    };
-    let result = pipeline::remesh(&field, &stages, &options, |p: Progress| {
+    let remesher = Remesher::new(options(&args)).with_stages(stages(&args)?);
+    let bar = progress_bar(args.quiet, mesh.n_faces() as u64);
+    let result = remesher.run_with(&mesh, metric.as_deref(), |p: Progress| {
+        bar.set_length(p.total as u64);
         bar.set_position((p.total - p.unprocessed) as u64);
         bar.set_message(format!("{} patches", p.patches));
     });
     bar.finish_and_clear();
-    let result = result?;
-    let out_unit = &result.mesh;
-    // Back to file units; input vertices keep their file coordinates bit for bit.
-    let out_file = to_file_units(
-        out_unit,
-        &result.locations,
-        field.reference(),
-        &file_mesh,
-        &norm,
-    );
-    // The certificates were taken in unit space; mapping back to file units rounds the new
-    // vertices, so the mesh that is written is certified again (exact): no degenerate face,
-    // and no self-intersection where the unit-space output had none.
-    conemesh::invariants::certify_no_degenerate_faces(&out_file)
-        .context("the output in file units (after mapping back from unit space)")?;
-    if result.report.certificate.no_self_intersections == 1 {
-        conemesh::invariants::certify_no_self_intersections(&out_file)
-            .context("the output in file units (after mapping back from unit space)")?;
-    }
+    let out = result?;
     let elapsed = t_start.elapsed().as_secs_f64();
-    // The yardstick, independent of the remesher: `conemesh eval` on the written output.
+    // The yardstick, independent of the remesher: `conemesh eval` on the output.
     let eval_opts = EvalOptions {
-        target: match args.ltar {
-            Some(l) => TargetLength::Absolute(l),
-            None => TargetLength::Factor(args.ltar_factor),
-        },
+        target: target(&args),
         self_intersections: false, // certified exactly by the pipeline already
         ..EvalOptions::default()
     };
-    let eval =
-        conemesh::quality::evaluate(&file_mesh, &out_file, user_metric.as_deref(), &eval_opts)?;
+    let eval = conemesh::quality::evaluate(
+        &out.input,
+        &out.mesh,
+        out.input_metric.as_deref(),
+        &eval_opts,
+    )?;
+    let r = &out.unit.report;
     println!(
         "{name}: {} faces → {} faces in {} patches, {elapsed:.2} s",
-        result.report.faces_in, result.report.faces_out, result.report.patches
+        r.faces_in, r.faces_out, r.patches
     );
     println!("{}", EvalReport::table_header());
     println!("{}", eval.table_row(&short_name));
-    let c = &result.report.certificate;
+    let c = &r.certificate;
     println!(
         "certified after each of {} patches: disk, bijective, planar, manifold, oriented, same topology, boundary kept, no degenerate/flipped faces; final self-intersections: {}",
-        result.report.patches,
+        r.patches,
         match (c.no_self_intersections, c.input_self_intersecting_pairs) {
             (1, _) => "none (exact)".to_string(),
             (_, Some(n)) => format!(
@@ -255,40 +183,21 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             _ => "not checked".to_string(),
         }
     );
-    let r = &result.report;
     if r.coarse_input {
-        let why = if r.options.coarse_input == CoarseInput::On {
-            "forced by --coarse on".to_string()
-        } else {
-            format!(
-                "the distance tolerance, not the metric, sets the size here: expected faces {:.0} in the metric, {:.0} with the fidelity scaling; --coarse off for the options as given",
-                r.expected_faces, r.expected_faces_fidelity
-            )
-        };
         println!(
-            "coarse-input profile ran ({} sweeps, fidelity floor {} of the mean input edge, {} rounds, persistent factors): {why}",
+            "coarse-input profile ran ({} sweeps, fidelity floor {} of the mean input edge, {} rounds, persistent factors)",
             r.options.sweeps, r.options.fidelity.min_edge_ratio, r.options.fidelity.rounds
         );
     }
-    let fb = &result.report.fallbacks;
-    if fb.kept_faces > 0 || fb.shrinks > 0 {
-        eprintln!(
-            "warning: {} patch attempt(s) failed their certificates and were retried smaller; {} face(s) (of the input, or of an earlier sweep) could not be remeshed and were kept as they were (details: --report, `fallbacks`)",
-            fb.failures.len(),
-            fb.kept_faces
-        );
+    for w in &out.warnings {
+        eprintln!("warning: {w}");
     }
     // Everything is computed; write the outputs (each atomically), the mesh first.
-    conemesh::io::write_mesh(&args.output, &out_file)
+    conemesh::io::write_mesh(&args.output, &out.mesh)
         .with_context(|| format!("writing {}", args.output.display()))?;
     println!("wrote {}", args.output.display());
     if let Some(p) = &args.write_metric {
-        let m: Vec<_> = result
-            .locations
-            .iter()
-            .map(|l| norm.metric_from_unit(&field.eval_at(l)))
-            .collect();
-        conemesh::io::sol::write_sol(p, &m, false)
+        conemesh::io::sol::write_sol(p, &out.output_metric(), false)
             .with_context(|| format!("writing {}", p.display()))?;
     }
     if let Some(p) = &args.report {
@@ -297,7 +206,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             "output": args.output,
             "seconds": elapsed,
             "peak_rss_mib": peak_rss_mib(),
-            "run": result.report,
+            "run": r,
             "eval": eval,
         });
         conemesh::io::write_bytes_atomic(p, serde_json::to_string_pretty(&json)?.as_bytes())
@@ -317,6 +226,75 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// `--ltar` or `--ltar-factor`. A metric length is the same in file units and in unit space
+/// (`Normalization`).
+fn target(args: &RemeshArgs) -> TargetLength {
+    match args.ltar {
+        Some(l) => TargetLength::Absolute(l),
+        None => TargetLength::Factor(args.ltar_factor),
+    }
+}
+
+/// The options of Algorithm 1 from the arguments.
+fn options(args: &RemeshArgs) -> RemeshOptions {
+    RemeshOptions {
+        seed: args.seed,
+        target: target(args),
+        check_self_intersections: !args.no_self_intersections,
+        fidelity: conemesh::fidelity::FidelityOptions {
+            max_deviation: args.hausd,
+            ..Default::default()
+        },
+        debug_dir: Some(args.debug_dir.clone().unwrap_or_else(|| {
+            args.output
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .map(PathBuf::from)
+                .unwrap_or_else(|| PathBuf::from("."))
+        })),
+        max_patches: args.max_patches,
+        sweeps: args.sweeps,
+        corner_defect: (args.corner_defect != 0.0).then_some(args.corner_defect),
+        feature_angle: (args.feature_angle != 0.0).then_some(args.feature_angle),
+        coarse_input: match args.coarse {
+            Coarse::Auto => CoarseInput::Auto,
+            Coarse::On => CoarseInput::On,
+            Coarse::Off => CoarseInput::Off,
+        },
+        ..RemeshOptions::default()
+    }
+}
+
+/// The three extension points by registry name, with their options.
+fn stages(args: &RemeshArgs) -> anyhow::Result<Stages> {
+    let mut strategy = Params::parse(&args.strategy_opt)?;
+    if let Some(r) = args.expand_rings {
+        strategy.set("expand_rings", r);
+    }
+    if let Some(m) = args.max_patch_faces {
+        strategy.set("max_faces", m);
+    }
+    Ok(Stages::from_registry(
+        (&args.strategy, strategy),
+        (&args.param, Params::parse(&args.param_opt)?),
+        (&args.remesher, Params::parse(&args.remesher_opt)?),
+    )?)
+}
+
+fn progress_bar(quiet: bool, total: u64) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new(total);
+    // A constant template; should it ever be refused, keep indicatif's default style.
+    if let Ok(style) = ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:40}] {pos}/{len} faces processed, {msg}",
+    ) {
+        b.set_style(style.progress_chars("=> "));
+    }
+    b
+}
+
 /// This process's peak resident memory in MiB (`VmHWM` of `/proc/self/status`, in kB; `None`
 /// where there is no such file, i.e. off Linux).
 fn peak_rss_mib() -> Option<f64> {
@@ -324,46 +302,4 @@ fn peak_rss_mib() -> Option<f64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb / 1024.0)
-}
-
-fn strategy(name: &str) -> anyhow::Result<Box<dyn conemesh::patches::PatchStrategy>> {
-    match conemesh::patches::strategy_by_name(name) {
-        Some(s) => Ok(s),
-        None => bail!(
-            "unknown patch strategy `{name}` (known: {})",
-            conemesh::patches::STRATEGY_NAMES.join(", ")
-        ),
-    }
-}
-
-/// Map the unit-space result back to file units. A vertex that sits exactly on an input
-/// vertex (one-hot barycentric location, bit-identical unit position) gets that vertex's file
-/// coordinates bit for bit; every other vertex is mapped by the inverse normalization.
-fn to_file_units(
-    out: &TriMesh,
-    locations: &[conemesh::SurfaceLocation],
-    reference: &TriMesh,
-    file_mesh: &TriMesh,
-    norm: &Normalization,
-) -> TriMesh {
-    let positions = out
-        .positions
-        .iter()
-        .zip(locations)
-        .map(|(p, loc)| {
-            for k in 0..3 {
-                if loc.bary[k] == 1.0 {
-                    let v = reference.triangles[loc.face.idx()][k];
-                    if reference.positions[v.idx()] == *p {
-                        return file_mesh.positions[v.idx()];
-                    }
-                }
-            }
-            norm.from_unit(p)
-        })
-        .collect();
-    TriMesh {
-        positions,
-        triangles: out.triangles.clone(),
-    }
 }

@@ -316,16 +316,58 @@ fn changed(what: &str, before: String, after: String) -> InvariantError {
     }
 }
 
-/// Per-component `(genus, boundary loops)` sorted, so that renumbered components compare
+/// The topology a run must keep: the number of components and boundary loops and the
+/// per-component `(genus, boundary loops)`, sorted so that renumbered components compare
 /// equal. A genus that is not a non-negative integer prints as `?`.
-fn component_signature(topo: &Topology) -> Vec<(Option<u32>, usize)> {
-    let mut v: Vec<(Option<u32>, usize)> = topo
-        .components()
-        .iter()
-        .map(|c| (c.genus, c.boundary_loops))
-        .collect();
-    v.sort_unstable();
-    v
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TopologySignature {
+    components: usize,
+    boundary_loops: usize,
+    per_component: Vec<(Option<u32>, usize)>,
+}
+
+impl TopologySignature {
+    /// The signature of a mesh's topology.
+    pub fn of(topo: &Topology) -> TopologySignature {
+        let mut per_component: Vec<(Option<u32>, usize)> = topo
+            .components()
+            .iter()
+            .map(|c| (c.genus, c.boundary_loops))
+            .collect();
+        per_component.sort_unstable();
+        TopologySignature {
+            components: topo.components().len(),
+            boundary_loops: topo.boundary_loops().len(),
+            per_component,
+        }
+    }
+
+    /// `Ok` when `after` equals `self`, else the first difference: components, boundary
+    /// loops, then the per-component genus and loops.
+    pub fn certify_same(&self, after: &TopologySignature) -> Result<(), InvariantError> {
+        if self.components != after.components {
+            return Err(changed(
+                "components",
+                self.components.to_string(),
+                after.components.to_string(),
+            ));
+        }
+        if self.boundary_loops != after.boundary_loops {
+            return Err(changed(
+                "boundary loops",
+                self.boundary_loops.to_string(),
+                after.boundary_loops.to_string(),
+            ));
+        }
+        if self.per_component != after.per_component {
+            return Err(changed(
+                "per-component genus and boundary loops",
+                fmt_signature(&self.per_component),
+                fmt_signature(&after.per_component),
+            ));
+        }
+        Ok(())
+    }
 }
 
 fn fmt_signature(v: &[(Option<u32>, usize)]) -> String {
@@ -344,23 +386,7 @@ fn fmt_signature(v: &[(Option<u32>, usize)]) -> String {
 /// (components may be renumbered).
 pub fn certify_same_topology(before: &TriMesh, after: &TriMesh) -> Result<(), InvariantError> {
     let (tb, ta) = (Topology::build(before), Topology::build(after));
-    let (cb, ca) = (tb.components().len(), ta.components().len());
-    if cb != ca {
-        return Err(changed("components", cb.to_string(), ca.to_string()));
-    }
-    let (lb, la) = (tb.boundary_loops().len(), ta.boundary_loops().len());
-    if lb != la {
-        return Err(changed("boundary loops", lb.to_string(), la.to_string()));
-    }
-    let (sb, sa) = (component_signature(&tb), component_signature(&ta));
-    if sb != sa {
-        return Err(changed(
-            "per-component genus and boundary loops",
-            fmt_signature(&sb),
-            fmt_signature(&sa),
-        ));
-    }
-    Ok(())
+    TopologySignature::of(&tb).certify_same(&TopologySignature::of(&ta))
 }
 
 /// A position as bits, with `-0.0` identified with `0.0` (the same point).
@@ -372,12 +398,15 @@ fn key(p: &Point3<f64>) -> [u64; 3] {
     ]
 }
 
-fn boundary_edges(topo: &Topology) -> impl Iterator<Item = EdgeKey> + '_ {
+
+/// The boundary edges of `mesh` (edges with one face), by vertex ids.
+pub fn boundary_edges(topo: &Topology) -> Vec<EdgeKey> {
     topo.edges()
         .iter()
         .zip(topo.edge_face_counts())
         .filter(|(_, &n)| n == 1)
         .map(|(e, _)| *e)
+        .collect()
 }
 
 /// Every boundary vertex of `before` is, bit for bit, the position of a vertex of `after`,
@@ -386,8 +415,27 @@ fn boundary_edges(topo: &Topology) -> impl Iterator<Item = EdgeKey> + '_ {
 /// vertices are checked first.
 pub fn certify_boundary_preserved(before: &TriMesh, after: &TriMesh) -> Result<(), InvariantError> {
     let (tb, ta) = (Topology::build(before), Topology::build(after));
-    let after_positions: HashSet<[u64; 3]> = after.positions.iter().map(key).collect();
-    let mut moved: Vec<VertexId> = boundary_edges(&tb)
+    certify_boundary_kept(before, &boundary_edges(&tb), after, &boundary_edges(&ta))
+}
+
+/// [`certify_boundary_preserved`] with the boundary edges of both meshes given (the pipeline
+/// keeps the input's and computes the working mesh's after every patch).
+pub fn certify_boundary_kept(
+    before: &TriMesh,
+    before_boundary: &[EdgeKey],
+    after: &TriMesh,
+    after_boundary: &[EdgeKey],
+) -> Result<(), InvariantError> {
+    if before_boundary.is_empty() {
+        return Ok(());
+    }
+    let after_positions: HashSet<[u64; 3]> = after_boundary
+        .iter()
+        .flat_map(|e| [e.0, e.1])
+        .map(|v| key(after.position(v)))
+        .collect();
+    let mut moved: Vec<VertexId> = before_boundary
+        .iter()
         .flat_map(|e| [e.0, e.1])
         .filter(|v| !after_positions.contains(&key(before.position(*v))))
         .collect();
@@ -397,16 +445,19 @@ pub fn certify_boundary_preserved(before: &TriMesh, after: &TriMesh) -> Result<(
         return Err(InvariantError::BoundaryVerticesMoved(Offenders(moved)));
     }
     let unordered = |a: [u64; 3], b: [u64; 3]| if a <= b { (a, b) } else { (b, a) };
-    let after_edges: HashSet<([u64; 3], [u64; 3])> = boundary_edges(&ta)
+    let after_edges: HashSet<([u64; 3], [u64; 3])> = after_boundary
+        .iter()
         .map(|e| unordered(key(after.position(e.0)), key(after.position(e.1))))
         .collect();
-    let missing: Vec<EdgeKey> = boundary_edges(&tb)
+    let missing: Vec<EdgeKey> = before_boundary
+        .iter()
         .filter(|e| {
             !after_edges.contains(&unordered(
                 key(before.position(e.0)),
                 key(before.position(e.1)),
             ))
         })
+        .copied()
         .collect();
     if !missing.is_empty() {
         return Err(InvariantError::BoundaryEdgesMissing(Offenders(missing)));

@@ -2,16 +2,18 @@
 //! enough to leave on. Each returns the offending elements by id in its error.
 //!
 //! One file per family: `mesh.rs` (manifold, oriented, degenerate, self-intersections,
-//! topology and boundary kept, flips against a reference surface), `disk.rs` (patches),
-//! `bijective.rs` (parameterizations), `planar.rs` (2D remeshing).
+//! topology and boundary kept), `flips.rs` (faces flipped against a reference surface),
+//! `candidate.rs` (a change to the working mesh before it is made: lifted patches, flips,
+//! moves), `disk.rs` (patches), `bijective.rs` (parameterizations), `planar.rs` (2D
+//! remeshing).
 
 pub mod mesh;
 
 pub use mesh::{
-    certify_boundary_preserved, certify_manifold, certify_manifold_at, certify_no_degenerate_faces,
+    boundary_edges, certify_boundary_kept, certify_boundary_preserved, certify_manifold, certify_manifold_at, certify_no_degenerate_faces,
     certify_no_self_intersections, certify_oriented, certify_same_topology, degenerate_faces,
     faces_intersect, is_degenerate, non_manifold_vertices, non_manifold_vertices_among,
-    self_intersections,
+    self_intersections, TopologySignature,
 };
 
 use crate::ids::{EdgeKey, FaceId, VertexId};
@@ -122,3 +124,9 @@ pub use bijective::*;
 
 mod planar;
 pub use planar::*;
+
+mod flips;
+pub use flips::FlipTest;
+
+mod candidate;
+pub use candidate::*;

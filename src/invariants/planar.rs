@@ -3,7 +3,7 @@
 
 use super::InvariantError;
 use crate::predicates::{orient2d, Sign};
-use crate::remesh2d::{PlanarDomain, PlanarMesh};
+use crate::mesh::{PlanarDomain, PlanarMesh};
 use nalgebra::Point2;
 use std::collections::HashMap;
 

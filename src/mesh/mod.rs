@@ -1,16 +1,28 @@
 //! The triangle mesh: positions + triangles are the source of truth (parry habit); all
 //! topology ([`Topology`]) is derived from them and can be rebuilt at any time.
 
+pub mod closest;
 pub mod generators;
 pub mod location;
+pub mod planar;
 pub mod topology;
 
+pub use closest::{parry_trimesh, SurfaceProjector};
 pub use location::SurfaceLocation;
+pub use planar::{PlanarDomain, PlanarMesh};
 pub use topology::{ComponentInfo, Topology};
 
 use crate::ids::{FaceId, VertexId};
 use nalgebra::{Point3, Vector3};
 use thiserror::Error;
+
+/// Axis-aligned bounding box `(min, max)` of `points`; `None` when there are none.
+pub fn bbox_of(
+    mut points: impl Iterator<Item = Point3<f64>>,
+) -> Option<(Point3<f64>, Point3<f64>)> {
+    let first = points.next()?;
+    Some(points.fold((first, first), |(lo, hi), p| (lo.inf(&p), hi.sup(&p))))
+}
 
 /// Errors raised when constructing a mesh from raw arrays.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -259,15 +271,7 @@ impl TriMesh {
     /// Axis-aligned bounding box `(min, max)` of the referenced and unreferenced vertices.
     /// Returns `None` for a mesh with no vertices.
     pub fn bbox(&self) -> Option<(Point3<f64>, Point3<f64>)> {
-        let first = *self.positions.first()?;
-        let (mut lo, mut hi) = (first, first);
-        for p in &self.positions {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-        Some((lo, hi))
+        bbox_of(self.positions.iter().copied())
     }
 
     /// Length of the bounding-box diagonal (0 for an empty mesh).
@@ -275,8 +279,9 @@ impl TriMesh {
         self.bbox().map(|(lo, hi)| (hi - lo).norm()).unwrap_or(0.0)
     }
 
-    /// Vertex normals: area-weighted (unnormalised face normals summed), normalised.
-    pub fn vertex_normals(&self) -> Vec<Vector3<f64>> {
+    /// The unnormalised face normals summed at each vertex (twice the area-weighted normal;
+    /// zero on isolated vertices).
+    pub fn area_weighted_normals(&self) -> Vec<Vector3<f64>> {
         let mut n = vec![Vector3::zeros(); self.n_vertices()];
         for f in self.faces() {
             let fnrm = self.face_normal_raw(f);
@@ -284,6 +289,12 @@ impl TriMesh {
                 n[v.idx()] += fnrm;
             }
         }
+        n
+    }
+
+    /// Vertex normals: area-weighted (unnormalised face normals summed), normalised.
+    pub fn vertex_normals(&self) -> Vec<Vector3<f64>> {
+        let mut n = self.area_weighted_normals();
         for x in &mut n {
             let l = x.norm();
             if l > 0.0 {

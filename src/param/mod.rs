@@ -3,12 +3,14 @@
 
 mod distortion;
 mod lscm;
+mod registry;
 mod sdirichlet;
 mod shaped;
 mod tutte;
 
 pub use distortion::{distortion, triangle_frames, TriangleFrame};
 pub use lscm::lscm;
+pub use registry::{parameterizer, PARAMETERIZERS};
 pub use sdirichlet::{
     initial_map, optimize_locally_injective, optimize_with_log, InitialMap, SdLog, SdOptions,
     SdProfile, SymmetricDirichlet,

@@ -78,7 +78,7 @@ pub(crate) fn finish_patch(
     let faces = disk.sorted_faces();
     let boundary = crate::invariants::certify_disk(ctx.mesh, &faces).map_err(|source| {
         PatchError::NotCertified {
-            patch: crate::ids::PatchId(u32::MAX),
+            patch: None,
             seed: seed_vertex,
             source,
         }

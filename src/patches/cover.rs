@@ -58,7 +58,7 @@ pub struct CoverRun {
     /// Their statistics (parallel to `patches`).
     pub stats: Vec<PatchStats>,
     /// For every face, the first patch that contained it.
-    pub patch_of_face: Vec<PatchId>,
+    pub patch_of_face: Vec<Option<PatchId>>,
     /// True when every face is covered.
     pub complete: bool,
 }
@@ -75,7 +75,7 @@ pub fn cover(
     let topology = Topology::build(mesh);
     let nf = mesh.n_faces();
     let mut processed = vec![false; nf];
-    let mut patch_of_face = vec![PatchId(u32::MAX); nf];
+    let mut patch_of_face: Vec<Option<PatchId>> = vec![None; nf];
     let mut remaining = nf;
     let mut patches = Vec::new();
     let mut stats = Vec::new();
@@ -94,7 +94,7 @@ pub fn cover(
             Ok(None) => break,
             Err(PatchError::NotCertified { seed, source, .. }) => {
                 return Err(PatchError::NotCertified {
-                    patch: id,
+                    patch: Some(id),
                     seed,
                     source,
                 })
@@ -107,7 +107,7 @@ pub fn cover(
         // The caller's certificate (the strategy's own boundary is not trusted).
         let boundary = crate::invariants::certify_disk(mesh, &patch.faces).map_err(|source| {
             PatchError::NotCertified {
-                patch: id,
+                patch: Some(id),
                 seed: patch.seed_vertex,
                 source,
             }
@@ -122,7 +122,7 @@ pub fn cover(
         for &f in &patch.faces {
             if !processed[f.idx()] {
                 processed[f.idx()] = true;
-                patch_of_face[f.idx()] = id;
+                patch_of_face[f.idx()] = Some(id);
                 remaining -= 1;
             }
         }

@@ -2,8 +2,13 @@
 //!
 //! Files: `cone_fit.rs` (Eq. 1-2), `growth_cost.rs` (Eq. 3), `grow.rs` (greedy growth with
 //! the exact disk rule), `expand.rs` (1-2 ring expansion), `cone.rs` (the paper's strategy),
-//! `kring.rs` (a second strategy), `extract.rs` (a patch as its own mesh), `cover.rs` (the
+//! `kring.rs` (a second strategy), `shrink.rs` (the retry ladder's smaller disk),
+//! `registry.rs` (name → strategy), `extract.rs` (a patch as its own mesh), `cover.rs` (the
 //! covering run of `conemesh patches`).
+//!
+//! A new strategy: a file with a type implementing [`PatchStrategy`] (`kring.rs` is the
+//! template), one row in [`STRATEGIES`], and `cargo test` runs its contract
+//! ([`crate::contract::patch_strategy`]).
 
 pub mod cone;
 pub mod cone_fit;
@@ -13,6 +18,8 @@ pub mod extract;
 pub mod grow;
 pub mod growth_cost;
 pub mod kring;
+mod registry;
+mod shrink;
 
 pub use cone::ConePatches;
 pub use cone_fit::{cone_error, cone_objective, fit_cone, fit_cone_normals};
@@ -21,25 +28,15 @@ pub use extract::{extract_patch, PatchMesh};
 pub use grow::{grow_patch, DiskPatch, Grown, Refusal};
 pub use growth_cost::{growth_cost, ConeOptions};
 pub use kring::KRingDisks;
-
-/// Names of the built-in strategies, default first (for `--strategy`).
-pub const STRATEGY_NAMES: &[&str] = &["cone", "kring"];
-
-/// A built-in strategy with its default options, by [`PatchStrategy::name`].
-pub fn strategy_by_name(name: &str) -> Option<Box<dyn PatchStrategy>> {
-    match name {
-        "cone" => Some(Box::new(ConePatches::default())),
-        "kring" => Some(Box::new(KRingDisks::default())),
-        _ => None,
-    }
-}
+pub use registry::{strategy, STRATEGIES};
+pub use shrink::shrink_breadth_first;
 
 use crate::ids::{EdgeKey, FaceId, PatchId, VertexId};
 use crate::mesh::{Topology, TriMesh};
 use nalgebra::Vector3;
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use thiserror::Error;
 
 /// Errors of patch generation.
@@ -49,10 +46,10 @@ pub enum PatchError {
     #[error("patch generation: {0}")]
     InvalidMesh(String),
     /// A produced patch failed its certificate.
-    #[error("patch {patch} (seed {seed}): {source}")]
+    #[error("patch{} (seed {seed}): {source}", patch.map(|p| format!(" {p}")).unwrap_or_default())]
     NotCertified {
-        /// the patch
-        patch: PatchId,
+        /// the patch, when the caller numbers them
+        patch: Option<PatchId>,
         /// its seed vertex
         seed: VertexId,
         /// the violated invariant
@@ -165,7 +162,65 @@ pub trait PatchStrategy: Send + Sync {
         ctx: &PatchContext<'_>,
         rng: &mut ChaCha8Rng,
     ) -> Result<Option<Patch>, PatchError>;
+    /// A smaller disk inside `faces` (a patch whose attempt failed), of about `target`
+    /// faces, containing an unprocessed face (`seed_face` when it is one). The same
+    /// contract as [`PatchStrategy::next_patch`]. Default: breadth first from the seed face
+    /// under the exact disk rule ([`shrink_breadth_first`]).
+    fn shrink(
+        &self,
+        ctx: &PatchContext<'_>,
+        faces: &[FaceId],
+        seed_face: FaceId,
+        target: usize,
+    ) -> Vec<FaceId> {
+        shrink_breadth_first(ctx, faces, seed_face, target)
+    }
 }
+/// A corner vertex all of whose faces are in `faces` (interior to the patch), if any.
+pub fn interior_corner(
+    mesh: &TriMesh,
+    topo: &Topology,
+    faces: &[FaceId],
+    corners: &[bool],
+) -> Option<VertexId> {
+    let mut count: HashMap<VertexId, usize> = HashMap::new();
+    for &f in faces {
+        for v in mesh.face(f) {
+            if corners.get(v.idx()).copied().unwrap_or(false) {
+                *count.entry(v).or_default() += 1;
+            }
+        }
+    }
+    let mut inside: Vec<VertexId> = count
+        .into_iter()
+        .filter(|(v, n)| !topo.is_boundary_vertex(*v) && *n == topo.vertex_faces(*v).len())
+        .map(|(v, _)| v)
+        .collect();
+    inside.sort_unstable();
+    inside.first().copied()
+}
+
+/// A feature edge shared by two faces of the patch (so inside it), the smallest if several.
+pub fn interior_feature(
+    mesh: &TriMesh,
+    faces: &[FaceId],
+    feature_edges: &HashSet<EdgeKey>,
+) -> Option<EdgeKey> {
+    let mut count: HashMap<EdgeKey, u32> = HashMap::new();
+    for f in faces {
+        let t = mesh.triangles[f.idx()];
+        for k in 0..3 {
+            *count.entry(EdgeKey::new(t[k], t[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    count
+        .into_iter()
+        .filter(|(e, c)| *c >= 2 && feature_edges.contains(e))
+        .map(|(e, _)| e)
+        .min()
+}
+
+
 
 #[cfg(test)]
 mod tests {

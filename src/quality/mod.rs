@@ -11,8 +11,7 @@
 mod distance;
 mod eval;
 
-pub(crate) use distance::parry_trimesh;
-pub use distance::{approximation_error, flips, Distance, FlipTest, SurfaceProjector};
+pub use distance::{approximation_error, flips, Distance};
 pub use eval::{evaluate, EvalOptions, EvalReport, EvalTimings, MeshSize, TargetLength};
 
 use crate::ids::{EdgeKey, VertexId};

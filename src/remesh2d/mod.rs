@@ -5,6 +5,7 @@ mod demo;
 mod domain;
 mod field;
 mod lct;
+mod registry;
 mod stats;
 mod transfer;
 
@@ -12,9 +13,11 @@ pub use demo::{demo_cases, run_demo_case, DemoDomain, DemoMetric};
 pub use domain::{metric_length, resample_polygon, triangulate_polygon};
 pub use field::PlanarMetricField;
 pub use lct::{remesh_planar, Lct, LctOptions};
+pub use registry::{planar_remesher, REMESHERS};
 pub use stats::{planar_quality, PlanarQuality};
 pub use transfer::{clamp_spd, pullback_corners, transfer_metric, TransferMethod, EIGEN_FLOOR_REL};
 
+pub use crate::mesh::{PlanarDomain, PlanarMesh};
 use nalgebra::{Matrix2, Point2};
 use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
@@ -42,32 +45,6 @@ pub enum Remesh2dError {
 pub trait Metric2d: Sync {
     /// The metric at `p`.
     fn metric(&self, p: &Point2<f64>) -> Matrix2<f64>;
-}
-
-/// The input of a planar remesher: a positively oriented triangulation of a simple polygon.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PlanarDomain {
-    /// Vertex positions.
-    pub points: Vec<Point2<f64>>,
-    /// Counter-clockwise triangles.
-    pub triangles: Vec<[u32; 3]>,
-    /// The boundary loop (counter-clockwise); these vertices and the edges between
-    /// consecutive ones are kept exactly.
-    pub boundary: Vec<u32>,
-    /// Interior edges that must also be kept (mesh boundary or feature lines).
-    pub constrained_edges: Vec<[u32; 2]>,
-}
-
-/// The output of a planar remesher.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PlanarMesh {
-    /// Vertex positions.
-    pub points: Vec<Point2<f64>>,
-    /// Counter-clockwise triangles.
-    pub triangles: Vec<[u32; 3]>,
-    /// For each output vertex, the input vertex it is (bit-identical position), if any.
-    /// Every boundary and constrained vertex of the input appears here.
-    pub origin: Vec<Option<u32>>,
 }
 
 /// The research extension point: remesh a planar domain to follow a metric, keeping the

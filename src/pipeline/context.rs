@@ -1,0 +1,222 @@
+//! The state of a run: [`RunContext`], what every patch reads and nothing changes, and
+//! [`LoopState`], the working mesh with everything kept in step with it.
+
+use super::error::PipelineError;
+use super::options::Stages;
+use super::records::{Certificate, Fallbacks, PatchRecord, Progress, StageTimes};
+use super::sizing::Plan;
+use crate::features::FeatureLines;
+use crate::fidelity::VertexFactors;
+use crate::ids::{EdgeKey, PatchId, VertexId};
+use crate::invariants::{self, FlipTest, TopologySignature};
+use crate::mesh::Topology;
+use crate::metric::MetricField;
+use crate::patches::PatchContext;
+use crate::stitch::WorkingMesh;
+use nalgebra::Vector3;
+use std::collections::HashSet;
+
+/// What every patch of a run reads: the metric, the plan, the stages, and what was certified
+/// or derived from the input once.
+pub struct RunContext<'a> {
+    /// The metric every quality is measured in (the input's, unscaled).
+    pub quality_field: &'a MetricField,
+    /// The sizes and the effective options.
+    pub plan: &'a Plan,
+    /// The extension points.
+    pub stages: &'a Stages,
+    /// The flip certificate against the reference.
+    pub flip_test: FlipTest,
+    /// Area-weighted vertex normals of the reference (the fidelity control's).
+    pub ref_normals: Vec<Vector3<f64>>,
+    /// Self-intersecting face pairs of the input (0 when not checked).
+    pub input_pairs: usize,
+    /// Candidates are checked for local self-intersections: the check is on and the input
+    /// is embedded (an input that self-intersects cannot be replaced by an embedded surface
+    /// on it).
+    pub embedded_input: bool,
+    /// The input's topology, certified an oriented manifold.
+    pub reference_topology: Topology,
+    /// The topology every working mesh must keep.
+    pub signature: TopologySignature,
+    /// The input's boundary edges.
+    pub input_boundary: Vec<EdgeKey>,
+    /// `corners[v]`: input vertex `v` is kept as a corner (its working-mesh id is stable;
+    /// new vertices are never corners).
+    pub corners: Vec<bool>,
+}
+
+impl<'a> RunContext<'a> {
+    /// Derive the context of a run on `field`'s reference; `reference_topology` is its
+    /// topology, already certified an oriented manifold.
+    pub fn new(
+        field: &'a MetricField,
+        reference_topology: Topology,
+        plan: &'a Plan,
+        stages: &'a Stages,
+    ) -> RunContext<'a> {
+        let reference = field.reference();
+        let o = &plan.options;
+        let input_pairs = match o.check_self_intersections {
+            true => invariants::self_intersections(reference).len(),
+            false => 0,
+        };
+        let corners = match o.corner_defect {
+            Some(d) => crate::patches::corner_vertices(reference, &reference_topology, d),
+            None => Vec::new(),
+        };
+        RunContext {
+            quality_field: field,
+            plan,
+            stages,
+            flip_test: FlipTest::new(reference),
+            ref_normals: reference.area_weighted_normals(),
+            input_pairs,
+            embedded_input: o.check_self_intersections && input_pairs == 0,
+            signature: TopologySignature::of(&reference_topology),
+            input_boundary: invariants::boundary_edges(&reference_topology),
+            reference_topology,
+            corners,
+        }
+    }
+
+    /// The metric the patches are remeshed in (with the a-priori fidelity scaling).
+    pub fn field(&self) -> &MetricField {
+        self.plan.remesh_field(self.quality_field)
+    }
+
+    /// Faces processed over all sweeps.
+    fn total_faces(&self, per_sweep: usize) -> usize {
+        per_sweep * self.plan.options.sweeps.max(1)
+    }
+}
+
+/// The working mesh and everything kept in step with it while the loop runs.
+pub struct LoopState {
+    /// The mesh being remeshed, its vertices' reference locations and processed flags.
+    pub work: WorkingMesh,
+    /// Its topology (rebuilt after every patch).
+    pub topo: Topology,
+    /// The feature lines split into it before the loop.
+    pub features: FeatureLines,
+    /// `pinned[v]`: corners and feature-line vertices, which no pass moves.
+    pub pinned: Vec<bool>,
+    /// The fidelity factor per working-mesh vertex.
+    pub factors: VertexFactors,
+    /// Which patch produced each working-mesh face (`None`: an input face).
+    pub face_patch: Vec<Option<PatchId>>,
+    /// Faces of the working mesh when the loop started (one sweep's work).
+    pub faces_per_sweep: usize,
+    /// The current sweep (1-based).
+    pub sweep: usize,
+    /// Patches done.
+    pub patches: usize,
+    /// The patch budget ran out.
+    pub budget_exhausted: bool,
+    /// Times and certificate counts.
+    pub counters: Counters,
+    /// Per-patch records.
+    pub records: Vec<PatchRecord>,
+    /// What the retry ladder did.
+    pub fallbacks: Fallbacks,
+}
+
+/// Per-stage times and certificate counts of a run.
+#[derive(Default)]
+pub struct Counters {
+    /// Wall time per stage.
+    pub times: StageTimes,
+    /// Certificates checked and held.
+    pub cert: Certificate,
+}
+
+impl LoopState {
+    /// The working mesh at the start: the reference, with its feature lines split to the
+    /// target length.
+    pub fn new(ctx: &RunContext<'_>) -> Result<LoopState, PipelineError> {
+        let reference = ctx.quality_field.reference();
+        let mut work = WorkingMesh::from_reference(reference);
+        let features = crate::features::split_to_target(
+            &mut work,
+            reference,
+            &ctx.reference_topology,
+            ctx.plan.options.feature_angle,
+            ctx.field().vertex_metrics(),
+            ctx.plan.l_tar,
+        )
+        .map_err(|e| PipelineError::Input(e.to_string()))?;
+        let pinned = (0..work.mesh.n_vertices())
+            .map(|v| {
+                ctx.corners.get(v).copied().unwrap_or(false)
+                    || features.is_pinned(VertexId::new(v))
+            })
+            .collect();
+        let topo = match work.mesh.n_faces() == reference.n_faces() {
+            true => ctx.reference_topology.clone(),
+            false => Topology::build(&work.mesh),
+        };
+        Ok(LoopState {
+            factors: VertexFactors::ones(work.mesh.n_vertices()),
+            face_patch: vec![None; work.mesh.n_faces()],
+            faces_per_sweep: work.mesh.n_faces(),
+            sweep: 1,
+            patches: 0,
+            budget_exhausted: false,
+            counters: Counters::default(),
+            records: Vec::new(),
+            fallbacks: Fallbacks::default(),
+            work,
+            topo,
+            features,
+            pinned,
+        })
+    }
+
+    /// Algorithm 1's loop condition: true while an unprocessed face remains, starting a
+    /// further sweep (every face unprocessed again) when one ends and more are asked for, and
+    /// false once the patch budget is spent.
+    pub fn face_remains(&mut self, ctx: &RunContext<'_>) -> bool {
+        let o = &ctx.plan.options;
+        if self.work.unprocessed() == 0 {
+            if self.sweep >= o.sweeps {
+                return false;
+            }
+            // A further sweep (our addition): the new patches' fixed boundaries run through
+            // the previous sweep's remeshed faces (edges near L_tar) instead of the input's
+            // edges, and the previous seams end up inside new patches.
+            self.sweep += 1;
+            self.work.processed.iter_mut().for_each(|p| *p = false);
+        }
+        if o.max_patches.is_some_and(|max| self.patches >= max) {
+            self.budget_exhausted = true;
+            return false;
+        }
+        true
+    }
+
+    /// What the strategy sees.
+    pub fn patch_context<'s>(&'s self, ctx: &'s RunContext<'_>) -> PatchContext<'s> {
+        PatchContext {
+            mesh: &self.work.mesh,
+            topology: &self.topo,
+            processed: &self.work.processed,
+            feature_edges: self.feature_edges(),
+            corners: Some(&ctx.corners),
+        }
+    }
+
+    /// The feature-line pieces, when there are any.
+    pub fn feature_edges(&self) -> Option<&HashSet<EdgeKey>> {
+        (!self.features.edges.is_empty()).then_some(&self.features.edges)
+    }
+
+    /// Progress after the current patch.
+    pub fn progress(&self, ctx: &RunContext<'_>) -> Progress {
+        let sweeps = ctx.plan.options.sweeps.max(1);
+        Progress {
+            patches: self.patches,
+            unprocessed: self.work.unprocessed() + (sweeps - self.sweep) * self.faces_per_sweep,
+            total: ctx.total_faces(self.faces_per_sweep),
+        }
+    }
+}

@@ -1,0 +1,187 @@
+//! After the loop of Algorithm 1: the surface passes of Sec. 3.4, the certificates of the
+//! whole output, and the report.
+
+use super::context::{LoopState, RunContext};
+use super::error::PipelineError;
+use super::records::{RemeshReport, RemeshResult, Warning};
+use super::replace::certify_input_boundary;
+use crate::ids::{EdgeKey, PatchId, VertexId};
+use crate::improve::{finishing_passes, PassCounts, SurfaceContext};
+use crate::invariants::{self, FacePair, InvariantError, Offenders, TopologySignature};
+use crate::mesh::Topology;
+use crate::pipeline::options::CoarseInput;
+use std::time::Instant;
+
+/// The connectivity and vertex position updates on the surface
+/// ([`crate::improve::finishing_passes`]), within the fidelity tolerance (unbounded when the
+/// control is off, `--hausd 0`).
+pub fn improve(ctx: &RunContext<'_>, state: &mut LoopState) -> PassCounts {
+    let o = &ctx.plan.options;
+    if !(o.edge_flips || o.relocate) {
+        return PassCounts::default();
+    }
+    let t0 = Instant::now();
+    let surface = SurfaceContext {
+        field: ctx.quality_field,
+        flip_test: &ctx.flip_test,
+        embedded_input: ctx.embedded_input,
+        tol: if ctx.plan.eps > 0.0 {
+            ctx.plan.eps
+        } else {
+            f64::INFINITY
+        },
+        feature_edges: (!state.features.edges.is_empty()).then_some(&state.features.edges),
+        pinned: &state.pinned,
+    };
+    let counts = finishing_passes(&surface, &mut state.work, o.edge_flips, o.relocate);
+    state.counters.times.certify += t0.elapsed().as_secs_f64();
+    counts
+}
+
+/// The certificates of the whole output: the working mesh once more (the per-patch manifold
+/// check was local, by induction, and the passes changed it since), every corner and
+/// feature-line piece where the run put it, and (exact) no self-intersections; then the mesh
+/// is compacted.
+pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(), PipelineError> {
+    let t0 = Instant::now();
+    state.topo = Topology::build(&state.work.mesh);
+    let pid = PatchId::new(state.patches);
+    let fail = |e: InvariantError| PipelineError::Certificate {
+        patch: pid,
+        seed: None,
+        violation: e,
+        debug_file: None,
+    };
+    let (mesh, topo) = (&state.work.mesh, &state.topo);
+    invariants::certify_manifold(mesh, topo).map_err(fail)?;
+    invariants::certify_oriented(mesh, topo).map_err(fail)?;
+    ctx.signature
+        .certify_same(&TopologySignature::of(topo))
+        .map_err(fail)?;
+    certify_input_boundary(ctx, state).map_err(fail)?;
+    certify_corners(ctx, state)?;
+    certify_features(state)?;
+    state.counters.times.certify += t0.elapsed().as_secs_f64();
+    state.work.compact();
+    let t0 = Instant::now();
+    if ctx.plan.options.check_self_intersections {
+        let pairs = invariants::self_intersections(&state.work.mesh);
+        let cert = &mut state.counters.cert;
+        if pairs.is_empty() {
+            cert.no_self_intersections = 1;
+        } else if ctx.input_pairs == 0 {
+            // An embedded input must give an embedded output.
+            return Err(PipelineError::Final(InvariantError::SelfIntersections(
+                Offenders(pairs.into_iter().map(|(a, b)| FacePair(a, b)).collect()),
+            )));
+        } else {
+            // An input that itself self-intersects (cow.off does, at 118 face pairs) cannot
+            // give an embedded output that lies on it; that is reported, not an error.
+            cert.self_intersecting_pairs = pairs.len();
+            cert.input_self_intersecting_pairs = Some(ctx.input_pairs);
+        }
+    }
+    state.counters.times.final_check = t0.elapsed().as_secs_f64();
+    Ok(())
+}
+
+/// Every corner is still a vertex of the working mesh, where the input had it.
+fn certify_corners(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), PipelineError> {
+    let mesh = &state.work.mesh;
+    let reference = ctx.quality_field.reference();
+    let mut used = vec![false; mesh.n_vertices()];
+    mesh.triangles
+        .iter()
+        .flatten()
+        .for_each(|v| used[v.idx()] = true);
+    match (0..ctx.corners.len()).find(|&v| {
+        ctx.corners[v] && (!used[v] || mesh.positions[v] != reference.positions[v])
+    }) {
+        Some(v) => Err(PipelineError::CornerLost(VertexId::new(v))),
+        None => Ok(()),
+    }
+}
+
+/// Every feature-line piece is still an edge of the working mesh, its vertices unmoved.
+fn certify_features(state: &LoopState) -> Result<(), PipelineError> {
+    let features = &state.features;
+    if features.edges.is_empty() {
+        return Ok(());
+    }
+    let mesh = &state.work.mesh;
+    let edges = crate::quality::unique_edges(mesh);
+    let mut pieces: Vec<EdgeKey> = features.edges.iter().copied().collect();
+    pieces.sort_unstable();
+    match pieces.into_iter().find(|e| {
+        edges.binary_search(e).is_err()
+            || [e.0, e.1]
+                .iter()
+                .any(|v| features.positions.get(v) != mesh.positions.get(v.idx()))
+    }) {
+        Some(e) => Err(PipelineError::FeatureLost(e)),
+        None => Ok(()),
+    }
+}
+
+/// The result of the run: the compacted mesh, its locations and provenance, and the report.
+pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -> RemeshResult {
+    let plan = ctx.plan;
+    let reference = ctx.quality_field.reference();
+    let cert = &state.counters.cert;
+    let mut warnings = Vec::new();
+    if plan.coarse {
+        warnings.push(Warning::CoarseProfile {
+            forced: plan.options.coarse_input == CoarseInput::On,
+            expected_faces: plan.expected,
+            expected_faces_fidelity: plan.expected_fidelity,
+        });
+    }
+    if !state.fallbacks.failures.is_empty() || state.fallbacks.kept_faces > 0 {
+        warnings.push(Warning::FailedAttempts {
+            attempts: state.fallbacks.failures.len(),
+            kept_faces: state.fallbacks.kept_faces,
+        });
+    }
+    if state.budget_exhausted {
+        warnings.push(Warning::PatchBudget {
+            patches: state.patches,
+            unprocessed: state.work.unprocessed(),
+        });
+    }
+    if let Some(input_pairs) = cert.input_self_intersecting_pairs {
+        warnings.push(Warning::InputSelfIntersects {
+            input_pairs,
+            output_pairs: cert.self_intersecting_pairs,
+        });
+    }
+    let report = RemeshReport {
+        options: plan.options.clone(),
+        stages: ctx.stages.names(),
+        l_avg: plan.l_avg,
+        l_tar: plan.l_tar,
+        patches: state.patches,
+        budget_exhausted: state.budget_exhausted,
+        times: state.counters.times,
+        certificate: state.counters.cert,
+        fallbacks: state.fallbacks,
+        patch_records: state.records,
+        faces_in: reference.n_faces(),
+        faces_out: state.work.mesh.n_faces(),
+        vertices_out: state.work.mesh.n_vertices(),
+        edge_flips: passes.flips,
+        vertex_moves: passes.moves,
+        corners: ctx.corners.iter().filter(|c| **c).count(),
+        feature_edges: state.features.input_edges,
+        feature_pieces: state.features.edges.len(),
+        expected_faces: plan.expected,
+        expected_faces_fidelity: plan.expected_fidelity,
+        coarse_input: plan.coarse,
+        warnings,
+    };
+    RemeshResult {
+        mesh: state.work.mesh,
+        locations: state.work.locations,
+        face_patch: state.face_patch,
+        report,
+    }
+}

@@ -1,0 +1,198 @@
+//! Options of Algorithm 1 and the research extension points it runs.
+
+use crate::fidelity::FidelityOptions;
+use crate::param::{Parameterizer, SymmetricDirichlet};
+use crate::patches::{ConePatches, PatchStrategy};
+use crate::registry::{Params, RegistryError};
+use crate::remesh2d::{Lct, PlanarRemesher, TransferMethod};
+use serde::Serialize;
+use std::path::PathBuf;
+
+pub use crate::quality::TargetLength;
+
+/// Options of Algorithm 1, with their defaults.
+#[derive(Clone, Debug, Serialize)]
+pub struct RemeshOptions {
+    /// Seed of the one RNG every stage draws from. Default 1.
+    pub seed: u64,
+    /// Target metric edge length. Default `Factor(1.5)` (1.5·L_avg, as the paper's Table 1).
+    pub target: TargetLength,
+    /// How the 3D metric is carried to the plane. Default [`TransferMethod::default`].
+    #[serde(skip)]
+    pub transfer: TransferMethod,
+    /// Run the exact self-intersection test on the final mesh. Default `true`.
+    pub check_self_intersections: bool,
+    /// Where offending patches are written when a certificate fails. Default `None`.
+    pub debug_dir: Option<PathBuf>,
+    /// Stop after this many patches: the run then ends `Ok` with the unreached faces kept as
+    /// they were, [`super::RemeshReport::budget_exhausted`] set and a
+    /// [`super::Warning::PatchBudget`]. Default `None` (no budget).
+    pub max_patches: Option<usize>,
+    /// Stop at the first failed patch attempt instead of shrinking the patch and retrying
+    /// (for invariant-checking runs that want every failure to be an error). Default `false`.
+    pub strict: bool,
+    /// Geometric fidelity control (our addition, [`crate::fidelity`]): patches whose lifted
+    /// triangles deviate from the reference by more than `max_deviation` are remeshed again
+    /// with the metric scaled up there; `max_deviation` also bounds how far the finishing
+    /// passes may move the surface.
+    pub fidelity: FidelityOptions,
+    /// How many times Algorithm 1 covers the surface (our addition; 1 = the paper). Each
+    /// further sweep marks every face unprocessed and runs the loop again on the working
+    /// mesh, so the previous sweep's seams (fixed patch boundaries) are remeshed. Default 1.
+    pub sweeps: usize,
+    /// Carry the 3D metric to the plane per triangle corner (`J_tᵀ M(v) J_t`, exact for the
+    /// piecewise-linear parameterization) instead of per vertex (Jacobians averaged around
+    /// the vertex); see [`crate::remesh2d::PlanarMetricField::with_corner_metrics`]. Only with
+    /// [`TransferMethod::JacobianPullback`]. Default `false` (paper-notes.md, Algorithm 1:
+    /// it cuts thin tips).
+    pub corner_pullback: bool,
+    /// After the loop, the connectivity update on the surface
+    /// ([`crate::improve::flip_pass`]). Default `true`.
+    pub edge_flips: bool,
+    /// After the flips, the vertex position update on the surface
+    /// ([`crate::improve::relocate_pass`]), then flips again. Default `true`.
+    pub relocate: bool,
+    /// Input vertices whose angle defect `|2π − Σθ|` is at least this many radians are kept
+    /// as vertices of the output (our addition, see [`crate::patches::corner_vertices`]): no
+    /// patch contains them in its interior and the relocation pass does not move them.
+    /// `None` keeps no vertex (the paper). Default `Some(1.0)`.
+    pub corner_defect: Option<f64>,
+    /// Feature lines (our addition, [`crate::features`]): input edges whose faces' normals
+    /// differ by more than this many degrees are split to the target length and kept as
+    /// edges of the output (no patch crosses them, no pass moves or flips them). `None`
+    /// keeps none (the paper). Default `None`.
+    pub feature_angle: Option<f64>,
+    /// Whether to run the coarse-input profile ([`RemeshOptions::coarse_profile`]): `Auto`
+    /// (default) runs it when the distance tolerance rather than the metric sets the output's
+    /// size: the a-priori fidelity scaling multiplies the expected face count
+    /// ([`super::expected_faces`]) by at least [`COARSE_RATIO`].
+    pub coarse_input: CoarseInput,
+}
+
+/// [`CoarseInput::Auto`] runs the coarse-input profile when the a-priori fidelity scaling
+/// multiplies the expected output face count ([`super::expected_faces`]) by at least this much.
+pub const COARSE_RATIO: f64 = 2.0;
+
+/// When [`super::remesh`] uses [`RemeshOptions::coarse_profile`] (paper-notes "Coarse inputs").
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum CoarseInput {
+    /// When the a-priori fidelity scaling multiplies [`super::expected_faces`] by at least
+    /// [`COARSE_RATIO`].
+    #[default]
+    Auto,
+    /// Always.
+    On,
+    /// Never (the options as given).
+    Off,
+}
+
+impl Default for RemeshOptions {
+    fn default() -> Self {
+        RemeshOptions {
+            seed: 1,
+            target: TargetLength::Factor(1.5),
+            transfer: TransferMethod::default(),
+            check_self_intersections: true,
+            debug_dir: None,
+            max_patches: None,
+            strict: false,
+            fidelity: FidelityOptions::default(),
+            sweeps: 1,
+            corner_pullback: false,
+            edge_flips: true,
+            relocate: true,
+            corner_defect: Some(1.0),
+            feature_angle: None,
+            coarse_input: CoarseInput::Auto,
+        }
+    }
+}
+
+impl RemeshOptions {
+    /// The options for an input coarser than its output (our addition, paper-notes "Coarse
+    /// inputs"): at least 3 sweeps, because the first sweep's fixed patch boundaries are the
+    /// input's edges, longer than the output's; the fidelity control's factors kept between
+    /// patches ([`FidelityOptions::persist`]), so the further sweeps do not start again from
+    /// the a-priori metric; its refinement floor at most 0.2 of the input's mean edge (0.5 is
+    /// about the output's own edge length on such an input, where the control could not
+    /// refine at all) and at least 4 rounds per patch.
+    pub fn coarse_profile(&self) -> RemeshOptions {
+        let mut o = self.clone();
+        o.sweeps = o.sweeps.max(3);
+        o.fidelity.persist = true;
+        o.fidelity.min_edge_ratio = o.fidelity.min_edge_ratio.min(0.2);
+        o.fidelity.rounds = o.fidelity.rounds.max(4);
+        o
+    }
+
+    /// Errors for option values no run can use, naming the option.
+    pub fn validate(&self) -> Result<(), String> {
+        let eps = self.fidelity.max_deviation;
+        if !(eps.is_finite() && eps >= 0.0) {
+            return Err(format!(
+                "fidelity tolerance {eps} is not a finite number ≥ 0"
+            ));
+        }
+        if let Some(d) = self.corner_defect {
+            if d.is_nan() || d <= 0.0 {
+                return Err(format!(
+                    "corner angle defect must be a positive number of radians, got {d}"
+                ));
+            }
+        }
+        if let Some(a) = self.feature_angle {
+            if !(a.is_finite() && a > 0.0 && a < 180.0) {
+                return Err(format!(
+                    "feature angle must be between 0 and 180 degrees, got {a}"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The research extension points, with the paper's methods as defaults. Built by name from
+/// the registries ([`crate::patches::STRATEGIES`], [`crate::param::PARAMETERIZERS`],
+/// [`crate::remesh2d::REMESHERS`]) or directly.
+pub struct Stages {
+    /// Sec. 3.2.
+    pub patches: Box<dyn PatchStrategy>,
+    /// Sec. 3.3, embedding.
+    pub parameterizer: Box<dyn Parameterizer>,
+    /// Sec. 3.3, planar remeshing.
+    pub remesher: Box<dyn PlanarRemesher>,
+}
+
+impl Default for Stages {
+    fn default() -> Self {
+        Stages {
+            patches: Box::new(ConePatches::default()),
+            parameterizer: Box::new(SymmetricDirichlet::default()),
+            remesher: Box::new(Lct::default()),
+        }
+    }
+}
+
+impl Stages {
+    /// The stages of registry rows by name, each with its `KEY=VALUE` options.
+    pub fn from_registry(
+        strategy: (&str, Params),
+        parameterizer: (&str, Params),
+        remesher: (&str, Params),
+    ) -> Result<Stages, RegistryError> {
+        Ok(Stages {
+            patches: crate::patches::strategy(strategy.0, strategy.1)?,
+            parameterizer: crate::param::parameterizer(parameterizer.0, parameterizer.1)?,
+            remesher: crate::remesh2d::planar_remesher(remesher.0, remesher.1)?,
+        })
+    }
+
+    /// The names in the report: strategy, parameterizer, remesher.
+    pub fn names(&self) -> [String; 3] {
+        [
+            self.patches.name().to_string(),
+            self.parameterizer.name().to_string(),
+            self.remesher.name().to_string(),
+        ]
+    }
+}

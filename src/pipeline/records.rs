@@ -1,0 +1,305 @@
+//! What a run of Algorithm 1 reports: per-stage times, certificate counts, per-patch records,
+//! the failed attempts of the retry ladder, typed warnings, and the report that `--report`
+//! serialises.
+
+use super::error::{Stage, StageError};
+use super::options::RemeshOptions;
+use crate::ids::{PatchId, VertexId};
+use crate::mesh::{SurfaceLocation, TriMesh};
+use crate::param::DistortionReport;
+use serde::ser::SerializeStruct;
+use serde::Serialize;
+use std::fmt;
+
+/// Wall time per stage, seconds.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StageTimes {
+    /// Patch generation and certify_disk.
+    pub patches: f64,
+    /// Parameterization (includes its certificate).
+    pub param: f64,
+    /// Metric transfer.
+    pub transfer: f64,
+    /// Planar remeshing (includes its certificate).
+    pub remesh2d: f64,
+    /// Lifting and projection.
+    pub lift: f64,
+    /// Fidelity measurement (the extra remeshing rounds count under `remesh2d` / `lift`).
+    pub fidelity: f64,
+    /// Stitching.
+    pub stitch: f64,
+    /// Working-mesh certificates after every patch, and the finishing passes (whose every
+    /// change is a certified candidate).
+    pub certify: f64,
+    /// Final self-intersection test.
+    pub final_check: f64,
+}
+
+/// How many times each certificate was checked and held (a failed check is either an error
+/// or, for a patch attempt, a recorded failure followed by a retry). Per accepted patch:
+/// `manifold`, `oriented`, `same_topology`, `boundary_preserved` once each (also for kept
+/// patches); per attempt that reached the stage: `disk`, `bijective`, `planar`; per remeshed
+/// (not kept) patch: `no_degenerate`, `no_flips` and, for an embedded input,
+/// `locally_embedded`.
+#[derive(Clone, Debug, Default, Serialize, PartialEq, Eq)]
+pub struct Certificate {
+    /// Patches certified to be topological disks.
+    pub disk: usize,
+    /// Parameterizations certified bijective (exact orient2d, simple boundary).
+    pub bijective: usize,
+    /// Planar remeshes certified (positive, same boundary, disk): the first remesh of each
+    /// attempt.
+    pub planar: usize,
+    /// The fidelity control's further planar remeshes of an attempt, each certified like
+    /// `planar`.
+    pub planar_refined: usize,
+    /// Working mesh edge- and vertex-manifold after the patch.
+    pub manifold: usize,
+    /// Working mesh consistently oriented after the patch.
+    pub oriented: usize,
+    /// Genus, components and boundary loops equal the input's after the patch.
+    pub same_topology: usize,
+    /// The input's boundary vertices and edges unchanged after the patch.
+    pub boundary_preserved: usize,
+    /// No new face degenerate (exact) after the patch.
+    pub no_degenerate: usize,
+    /// No new face flipped against the reference after the patch.
+    pub no_flips: usize,
+    /// Candidates certified free of local self-intersections (exact; only for an embedded
+    /// input).
+    pub locally_embedded: usize,
+    /// Final mesh free of self-intersections (exact), 0 if not checked.
+    pub no_self_intersections: usize,
+    /// Self-intersecting face pairs of the output; non-zero only when the input itself
+    /// self-intersects (otherwise the run fails).
+    pub self_intersecting_pairs: usize,
+    /// Self-intersecting face pairs of the input, computed only when the output has some.
+    pub input_self_intersecting_pairs: Option<usize>,
+    /// Patches whose parameterizer fell back to its last certified iterate.
+    pub param_fallbacks: usize,
+}
+
+/// Per-patch record.
+#[derive(Clone, Debug, Serialize)]
+pub struct PatchRecord {
+    /// Patch id.
+    pub id: PatchId,
+    /// Seed vertex (working-mesh id at the time).
+    pub seed: VertexId,
+    /// Faces replaced.
+    pub faces_in: usize,
+    /// Of which unprocessed before.
+    pub unprocessed_in: usize,
+    /// Faces produced.
+    pub faces_out: usize,
+    /// Cone angle in degrees, if the strategy fits one.
+    pub cone_angle_deg: Option<f64>,
+    /// Distortion of its parameterization.
+    pub distortion: DistortionReport,
+    /// Failed attempts before this one (each shrank the patch).
+    pub retries: usize,
+    /// Even the smallest attempt failed: the faces were kept unchanged.
+    pub kept: bool,
+    /// Extra remeshing rounds of the fidelity control.
+    pub fidelity_rounds: usize,
+}
+
+/// One failed attempt of the retry ladder: which patch, how many faces it had, the stage
+/// that failed and its typed error.
+#[derive(Clone, Debug)]
+pub struct FailedAttempt {
+    /// The patch.
+    pub patch: PatchId,
+    /// Its size at this attempt (each retry shrinks it).
+    pub faces: usize,
+    /// The stage that failed.
+    pub stage: Stage,
+    /// Why.
+    pub error: StageError,
+}
+
+impl fmt::Display for FailedAttempt {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} ({} faces): {}: {}",
+            self.patch, self.faces, self.stage, self.error
+        )
+    }
+}
+
+impl Serialize for FailedAttempt {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut st = s.serialize_struct("FailedAttempt", 5)?;
+        st.serialize_field("patch", &self.patch)?;
+        st.serialize_field("faces", &self.faces)?;
+        st.serialize_field("stage", &self.stage)?;
+        st.serialize_field("certificate", &self.error.is_certificate())?;
+        st.serialize_field("error", &self.error.to_string())?;
+        st.end()
+    }
+}
+
+/// What the retry ladder did (see [`super::remesh`]).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Fallbacks {
+    /// Patches shrunk after a failed attempt.
+    pub shrinks: usize,
+    /// Unprocessed faces (of the input, or of an earlier sweep) kept unchanged because even a
+    /// minimal patch failed.
+    pub kept_faces: usize,
+    /// Every failed attempt.
+    pub failures: Vec<FailedAttempt>,
+}
+
+/// Something the user should know about a finished, certified run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Warning {
+    /// Patch attempts failed their certificates and were retried smaller; some faces may have
+    /// been kept as they were.
+    FailedAttempts {
+        /// failed attempts
+        attempts: usize,
+        /// faces kept unchanged
+        kept_faces: usize,
+    },
+    /// [`RemeshOptions::max_patches`] ran out: the faces no patch reached are the input's.
+    PatchBudget {
+        /// patches made
+        patches: usize,
+        /// faces left unprocessed (kept as they were)
+        unprocessed: usize,
+    },
+    /// The input self-intersects, so the output (which lies on it) does too.
+    InputSelfIntersects {
+        /// self-intersecting face pairs of the input
+        input_pairs: usize,
+        /// of the output
+        output_pairs: usize,
+    },
+    /// The coarse-input profile ran ([`RemeshOptions::coarse_profile`]).
+    CoarseProfile {
+        /// `--coarse on` forced it (else the automatic rule chose it)
+        forced: bool,
+        /// [`super::expected_faces`] in the metric alone
+        expected_faces: f64,
+        /// the same with the a-priori fidelity scaling
+        expected_faces_fidelity: f64,
+    },
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Warning::FailedAttempts { attempts, kept_faces } => write!(
+                f,
+                "{attempts} patch attempt(s) failed their certificates and were retried smaller; \
+                 {kept_faces} face(s) (of the input, or of an earlier sweep) could not be remeshed \
+                 and were kept as they were (details: --report, `fallbacks`)"
+            ),
+            Warning::PatchBudget { patches, unprocessed } => write!(
+                f,
+                "the patch budget ran out after {patches} patches: {unprocessed} face(s) were \
+                 not reached and are kept as they were"
+            ),
+            Warning::InputSelfIntersects { input_pairs, output_pairs } => write!(
+                f,
+                "the input itself self-intersects ({input_pairs} face pairs); the output, which \
+                 lies on it, has {output_pairs}"
+            ),
+            Warning::CoarseProfile { forced: true, .. } => {
+                write!(f, "coarse-input profile ran: forced by --coarse on")
+            }
+            Warning::CoarseProfile {
+                expected_faces,
+                expected_faces_fidelity,
+                ..
+            } => write!(
+                f,
+                "coarse-input profile ran: the distance tolerance, not the metric, sets the size \
+                 here: expected faces {expected_faces:.0} in the metric, \
+                 {expected_faces_fidelity:.0} with the fidelity scaling; --coarse off for the \
+                 options as given"
+            ),
+        }
+    }
+}
+
+/// The report of a run (serialised into `--report`).
+#[derive(Clone, Debug, Serialize)]
+pub struct RemeshReport {
+    /// Options used (after the coarse-input profile, when it ran).
+    pub options: RemeshOptions,
+    /// Strategy / parameterizer / remesher names.
+    pub stages: [String; 3],
+    /// Mean metric edge length of the input (L_avg).
+    pub l_avg: f64,
+    /// Target metric edge length (L_tar).
+    pub l_tar: f64,
+    /// Number of patches.
+    pub patches: usize,
+    /// The patch budget ([`RemeshOptions::max_patches`]) ran out before every face was
+    /// processed.
+    pub budget_exhausted: bool,
+    /// Per-stage times.
+    pub times: StageTimes,
+    /// Certificates.
+    pub certificate: Certificate,
+    /// What the retry ladder did.
+    pub fallbacks: Fallbacks,
+    /// Per-patch records.
+    pub patch_records: Vec<PatchRecord>,
+    /// Input faces.
+    pub faces_in: usize,
+    /// Output faces.
+    pub faces_out: usize,
+    /// Output vertices.
+    pub vertices_out: usize,
+    /// Edges flipped by the connectivity update after the loop ([`RemeshOptions::edge_flips`]).
+    pub edge_flips: usize,
+    /// Vertex moves of the vertex position update after the loop ([`RemeshOptions::relocate`]).
+    pub vertex_moves: usize,
+    /// Input vertices kept as corners ([`RemeshOptions::corner_defect`]); each is certified
+    /// to be a vertex of the output at its input position.
+    pub corners: usize,
+    /// Input edges kept as feature lines ([`RemeshOptions::feature_angle`]).
+    pub feature_edges: usize,
+    /// The pieces they were split into; each is certified to be an edge of the output, its
+    /// vertices where the split put them.
+    pub feature_pieces: usize,
+    /// [`super::expected_faces`] of the input at L_tar in the metric alone.
+    pub expected_faces: f64,
+    /// The same with the a-priori fidelity scaling (before any coarse-input profile).
+    pub expected_faces_fidelity: f64,
+    /// Whether the coarse-input profile ran (`options` then holds the profile's values).
+    pub coarse_input: bool,
+    /// Everything the user should know about this run.
+    pub warnings: Vec<Warning>,
+}
+
+/// The outcome of Algorithm 1 (unit-diagonal space; [`super::Remesher`] maps it back to file
+/// units).
+#[derive(Clone, Debug)]
+pub struct RemeshResult {
+    /// The remeshed surface (unit-diagonal space, compacted).
+    pub mesh: TriMesh,
+    /// Reference location of every output vertex.
+    pub locations: Vec<SurfaceLocation>,
+    /// Which patch produced each output face (`None`: an input face no patch replaced, i.e.
+    /// kept unchanged). Diagnostics: where the seams and kept faces are.
+    pub face_patch: Vec<Option<PatchId>>,
+    /// What was done and certified.
+    pub report: RemeshReport,
+}
+
+/// Progress reported after every patch.
+#[derive(Copy, Clone, Debug)]
+pub struct Progress {
+    /// Patches done.
+    pub patches: usize,
+    /// Faces still to process over all sweeps (strictly decreasing).
+    pub unprocessed: usize,
+    /// Faces to process over all sweeps at the start.
+    pub total: usize,
+}

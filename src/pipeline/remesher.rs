@@ -1,0 +1,181 @@
+//! The whole job in one call: a mesh in file units (and optionally a user metric in file
+//! units) in, a certified remeshed mesh in file units, its report and typed warnings out.
+//!
+//! ```no_run
+//! use conemesh::pipeline::{RemeshOptions, Remesher};
+//! let loaded = conemesh::io::read_mesh(std::path::Path::new("bunny.off"))?;
+//! let out = Remesher::new(RemeshOptions::default()).run(&loaded.mesh)?;
+//! conemesh::io::write_mesh(std::path::Path::new("bunny-remeshed.obj"), &out.mesh)?;
+//! for w in &out.warnings {
+//!     eprintln!("warning: {w}");
+//! }
+//! # Ok::<(), conemesh::Error>(())
+//! ```
+
+use super::error::PipelineError;
+use super::options::{RemeshOptions, Stages};
+use super::records::{Progress, RemeshResult, Warning};
+use crate::invariants;
+use crate::mesh::{SurfaceLocation, TriMesh};
+use crate::metric::{MetricField, MetricOptions, Normalization};
+use nalgebra::Matrix3;
+
+/// Algorithm 1 from a mesh in file units: [`Remesher::run`] drops unreferenced vertices,
+/// scales the input to unit bounding-box diagonal, builds the metric (the curvature metric
+/// of Sec. 3.1, or the user's), runs [`super::remesh`], maps the result back to file units
+/// (surviving input vertices bit for bit) and re-certifies that mesh exactly.
+pub struct Remesher {
+    /// Options of Algorithm 1.
+    pub options: RemeshOptions,
+    /// The extension points (the paper's methods by default).
+    pub stages: Stages,
+    /// How the curvature metric is estimated (when no user metric is given).
+    pub metric: MetricOptions,
+}
+
+/// The result of [`Remesher::run`].
+pub struct Remeshed {
+    /// The output in file units.
+    pub mesh: TriMesh,
+    /// The unit-space result: mesh, reference locations, provenance and report.
+    pub unit: RemeshResult,
+    /// The input after dropping unreferenced vertices (the reference, in file units).
+    pub input: TriMesh,
+    /// The user metric at the vertices of `input` (file units), when one was given.
+    pub input_metric: Option<Vec<Matrix3<f64>>>,
+    /// The scaling between file units and unit space.
+    pub normalization: Normalization,
+    /// The metric field on the unit-space input.
+    pub field: MetricField,
+    /// What the user should know (also in `unit.report.warnings`).
+    pub warnings: Vec<Warning>,
+}
+
+impl Remeshed {
+    /// The metric at every output vertex, in file units (what `--write-metric` writes).
+    pub fn output_metric(&self) -> Vec<Matrix3<f64>> {
+        self.unit
+            .locations
+            .iter()
+            .map(|l| self.normalization.metric_from_unit(&self.field.eval_at(l)))
+            .collect()
+    }
+}
+
+impl Remesher {
+    /// A remesher with `options` and the paper's stages.
+    pub fn new(options: RemeshOptions) -> Remesher {
+        Remesher {
+            options,
+            stages: Stages::default(),
+            metric: MetricOptions::default(),
+        }
+    }
+
+    /// The same with other extension points.
+    pub fn with_stages(self, stages: Stages) -> Remesher {
+        Remesher { stages, ..self }
+    }
+
+    /// Remesh `input` (file units) in its curvature metric.
+    pub fn run(&self, input: &TriMesh) -> Result<Remeshed, PipelineError> {
+        self.run_with(input, None, |_| {})
+    }
+
+    /// Remesh `input` in a user metric: one symmetric tensor per input vertex, in file
+    /// units, positive definite on the surface's tangent plane.
+    pub fn run_with_metric(
+        &self,
+        input: &TriMesh,
+        metric: &[Matrix3<f64>],
+    ) -> Result<Remeshed, PipelineError> {
+        self.run_with(input, Some(metric), |_| {})
+    }
+
+    /// [`Remesher::run`] or [`Remesher::run_with_metric`], reporting progress after every
+    /// patch.
+    pub fn run_with(
+        &self,
+        input: &TriMesh,
+        metric: Option<&[Matrix3<f64>]>,
+        on_progress: impl FnMut(Progress),
+    ) -> Result<Remeshed, PipelineError> {
+        if let Some(m) = metric {
+            if m.len() != input.n_vertices() {
+                return Err(PipelineError::Input(format!(
+                    "the metric has {} tensors for {} vertices",
+                    m.len(),
+                    input.n_vertices()
+                )));
+            }
+        }
+        // Unreferenced vertices carry no surface; drop them. The compaction keeps the order of
+        // the other vertices, and the user metric follows them through the map.
+        let (file_mesh, map) = input.without_unreferenced_vertices();
+        let norm = Normalization::of(&file_mesh);
+        let reference = norm.apply(&file_mesh);
+        let input_metric = metric.map(|m| {
+            let mut kept = vec![Matrix3::zeros(); file_mesh.n_vertices()];
+            for (old, new) in map.iter().enumerate() {
+                if let Some(n) = new {
+                    kept[n.idx()] = m[old];
+                }
+            }
+            kept
+        });
+        let field = match &input_metric {
+            Some(m) => MetricField::new(reference, m.iter().map(|m| norm.metric_to_unit(m)).collect())?,
+            None => MetricField::from_curvature(reference, &self.metric)?,
+        };
+        let unit = super::remesh(&field, &self.stages, &self.options, on_progress)?;
+        let mesh = to_file_units(&unit.mesh, &unit.locations, field.reference(), &file_mesh, &norm);
+        // The certificates were taken in unit space; mapping back to file units rounds the new
+        // vertices, so the mesh that is returned is certified again (exact): no degenerate
+        // face, and no self-intersection where the unit-space output had none.
+        invariants::certify_no_degenerate_faces(&mesh).map_err(PipelineError::FileUnits)?;
+        if unit.report.certificate.no_self_intersections == 1 {
+            invariants::certify_no_self_intersections(&mesh).map_err(PipelineError::FileUnits)?;
+        }
+        Ok(Remeshed {
+            mesh,
+            warnings: unit.report.warnings.clone(),
+            unit,
+            input: file_mesh,
+            input_metric,
+            normalization: norm,
+            field,
+        })
+    }
+}
+
+/// Map the unit-space result back to file units. A vertex that sits exactly on an input
+/// vertex (one-hot barycentric location, bit-identical unit position) gets that vertex's file
+/// coordinates bit for bit; every other vertex is mapped by the inverse normalization.
+fn to_file_units(
+    out: &TriMesh,
+    locations: &[SurfaceLocation],
+    reference: &TriMesh,
+    file_mesh: &TriMesh,
+    norm: &Normalization,
+) -> TriMesh {
+    let positions = out
+        .positions
+        .iter()
+        .zip(locations)
+        .map(|(p, loc)| {
+            for k in 0..3 {
+                if loc.bary[k] == 1.0 {
+                    let v = reference.triangles[loc.face.idx()][k];
+                    if reference.positions[v.idx()] == *p {
+                        return file_mesh.positions[v.idx()];
+                    }
+                }
+            }
+            norm.from_unit(p)
+        })
+        .collect();
+    TriMesh {
+        positions,
+        triangles: out.triangles.clone(),
+    }
+}

@@ -1,0 +1,224 @@
+//! Sizing, resolved once into a [`Plan`] before the loop: L_avg and L_tar, the fidelity
+//! tolerance and its a-priori metric scaling, the expected output size, and whether the
+//! coarse-input profile runs.
+
+use super::error::PipelineError;
+use super::options::{CoarseInput, RemeshOptions, TargetLength, COARSE_RATIO};
+use crate::fidelity;
+use crate::ids::VertexId;
+use crate::mesh::{Topology, TriMesh};
+use crate::metric::MetricField;
+use nalgebra::Matrix3;
+
+/// Largest expected output ([`expected_faces`] in the metric at L_tar) a run accepts.
+pub const MAX_EXPECTED_FACES: f64 = 1e8;
+
+/// Everything a run derives from the input and the options before its first patch.
+pub struct Plan {
+    /// The options the run uses: the caller's, or [`RemeshOptions::coarse_profile`] of them.
+    pub options: RemeshOptions,
+    /// Mean metric edge length of the input.
+    pub l_avg: f64,
+    /// Target metric edge length.
+    pub l_tar: f64,
+    /// Fidelity tolerance (unit space; 0 = off).
+    pub eps: f64,
+    /// The fidelity control's refinement floor (unit-space length).
+    pub min_edge: f64,
+    /// The a-priori fidelity factor per reference vertex (empty when the control is off).
+    pub fid_scale: Vec<f64>,
+    /// [`expected_faces`] in the metric alone.
+    pub expected: f64,
+    /// The same with the a-priori scaling of the caller's options (decides the profile).
+    pub expected_fidelity: f64,
+    /// The coarse-input profile runs.
+    pub coarse: bool,
+    /// The metric with the a-priori scaling applied, when there is one.
+    scaled: Option<MetricField>,
+}
+
+impl Plan {
+    /// Resolve the sizes of a run on `field`'s reference mesh (whose topology is `topo`).
+    /// Errors for an empty input, option values no run can use, and a target length that is
+    /// not a finite positive number or would give more than [`MAX_EXPECTED_FACES`] faces.
+    pub fn resolve(
+        field: &MetricField,
+        topo: &Topology,
+        options: &RemeshOptions,
+    ) -> Result<Plan, PipelineError> {
+        let reference = field.reference();
+        if reference.n_faces() == 0 {
+            return Err(PipelineError::Input("the input mesh has no faces".into()));
+        }
+        options.validate().map_err(PipelineError::Input)?;
+        let l_avg = crate::quality::edge_length_average(reference, field.vertex_metrics());
+        let l_tar = match options.target {
+            TargetLength::Factor(f) => f * l_avg,
+            TargetLength::Absolute(l) => l,
+        };
+        if !(l_tar.is_finite() && l_tar > 0.0) {
+            return Err(PipelineError::Input(format!(
+                "target edge length {l_tar} is not a positive finite number (L_avg = {l_avg})"
+            )));
+        }
+        let expected = expected_faces(reference, field.vertex_metrics(), &[], l_tar);
+        // A target far below the input's size would run for hours and exhaust memory: refuse
+        // it up front, naming the count.
+        if expected.is_nan() || expected > MAX_EXPECTED_FACES {
+            return Err(PipelineError::Input(format!(
+                "target edge length {l_tar:e} is too small for this input: the output would have \
+                 about {expected:.3e} faces (more than {MAX_EXPECTED_FACES:e})"
+            )));
+        }
+        let (mut min_edge, mut fid_scale) = a_priori(field, topo, options, l_tar);
+        let expected_fidelity =
+            expected_faces(reference, field.vertex_metrics(), &fid_scale, l_tar);
+        // An input where the distance tolerance, not the metric, sets the output's size runs
+        // the coarse-input profile (paper-notes "Coarse inputs"); its finer floor needs the
+        // a-priori scaling again.
+        let coarse = match options.coarse_input {
+            CoarseInput::On => true,
+            CoarseInput::Off => false,
+            CoarseInput::Auto => expected_fidelity >= COARSE_RATIO * expected,
+        };
+        let options = if coarse {
+            let profile = options.coarse_profile();
+            (min_edge, fid_scale) = a_priori(field, topo, &profile, l_tar);
+            profile
+        } else {
+            options.clone()
+        };
+        let scaled = if fid_scale.is_empty() {
+            None
+        } else {
+            let metrics = field
+                .vertex_metrics()
+                .iter()
+                .zip(&fid_scale)
+                .map(|(m, f)| m * *f)
+                .collect();
+            Some(
+                MetricField::new(reference.clone(), metrics)
+                    .map_err(|e| PipelineError::Input(format!("fidelity-scaled metric: {e}")))?,
+            )
+        };
+        Ok(Plan {
+            eps: options.fidelity.max_deviation,
+            options,
+            l_avg,
+            l_tar,
+            min_edge,
+            fid_scale,
+            expected,
+            expected_fidelity,
+            coarse,
+            scaled,
+        })
+    }
+
+    /// The metric the patches are remeshed in: `unscaled` with the a-priori fidelity scaling,
+    /// when there is one. Every quality measure uses `unscaled`.
+    pub fn remesh_field<'a>(&'a self, unscaled: &'a MetricField) -> &'a MetricField {
+        self.scaled.as_ref().unwrap_or(unscaled)
+    }
+}
+
+/// A-priori fidelity scaling (our addition, [`fidelity::a_priori_scale`]): the metric is
+/// scaled up isotropically where a triangle of the target size would cut off more of the
+/// reference than the tolerance allows. L_tar is from the unscaled metric, as is every
+/// quality measure. Returns the refinement floor and the factor per reference vertex (empty
+/// when the control is off).
+fn a_priori(
+    field: &MetricField,
+    topo: &Topology,
+    o: &RemeshOptions,
+    l_tar: f64,
+) -> (f64, Vec<f64>) {
+    let reference = field.reference();
+    let (sum, n) = reference.faces().fold((0.0, 0usize), |(s, n), f| {
+        let [a, b, c] = reference.face_points(f);
+        (s + (b - a).norm() + (c - b).norm() + (a - c).norm(), n + 3)
+    });
+    let min_edge = o.fidelity.min_edge_ratio * if n == 0 { 0.0 } else { sum / n as f64 };
+    let eps = o.fidelity.max_deviation;
+    let fid_scale = if eps > 0.0 {
+        fidelity::a_priori_scale(reference, topo, field.vertex_metrics(), l_tar, eps, min_edge)
+    } else {
+        Vec::new()
+    };
+    (min_edge, fid_scale)
+}
+
+/// The number of faces an output of `reference` should have: its area in the metric (the
+/// mean of the vertex tensors `metrics[v]·scale[v]` per face; `scale` empty = 1) over the area
+/// √3/4·L_tar² of an equilateral triangle of side `l_tar`.
+pub fn expected_faces(
+    reference: &TriMesh,
+    metrics: &[Matrix3<f64>],
+    scale: &[f64],
+    l_tar: f64,
+) -> f64 {
+    let s = |v: VertexId| scale.get(v.idx()).copied().unwrap_or(1.0);
+    let area: f64 = reference
+        .faces()
+        .map(|f| {
+            let t = reference.face(f);
+            let m = t
+                .iter()
+                .map(|v| metrics[v.idx()] * s(*v))
+                .sum::<Matrix3<f64>>()
+                / 3.0;
+            let q = crate::quality::metric_sqrt(&m);
+            let [a, b, c] = reference.face_points(f);
+            0.5 * (q * (b - a)).cross(&(q * (c - a))).norm()
+        })
+        .sum();
+    area / (3f64.sqrt() / 4.0 * l_tar * l_tar)
+}
+
+/// The expected output face counts of a run with `options` ([`expected_faces`] at its L_tar,
+/// in the metric alone and with the a-priori fidelity scaling) and whether
+/// [`CoarseInput::Auto`] would run the coarse-input profile.
+pub fn coarse_input_estimate(
+    field: &MetricField,
+    options: &RemeshOptions,
+) -> Result<(f64, f64, bool), PipelineError> {
+    let topo = Topology::build(field.reference());
+    let auto = RemeshOptions {
+        coarse_input: CoarseInput::Auto,
+        ..options.clone()
+    };
+    let plan = Plan::resolve(field, &topo, &auto)?;
+    Ok((plan.expected, plan.expected_fidelity, plan.coarse))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point3;
+
+    /// A flat unit square in the identity metric (restricted to the plane): its area over
+    /// that of an equilateral triangle of side L; a scale of 4 everywhere quadruples it.
+    #[test]
+    fn expected_faces_of_a_flat_square() {
+        let m = TriMesh {
+            positions: vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(1.0, 1.0, 0.0),
+                Point3::new(0.0, 1.0, 0.0),
+            ],
+            triangles: vec![
+                [VertexId(0), VertexId(1), VertexId(2)],
+                [VertexId(0), VertexId(2), VertexId(3)],
+            ],
+        };
+        let id = vec![Matrix3::identity(); 4];
+        let l = 0.1;
+        let want = 1.0 / (3f64.sqrt() / 4.0 * l * l);
+        let got = expected_faces(&m, &id, &[], l);
+        assert!((got - want).abs() < 1e-9 * want, "{got} vs {want}");
+        let got4 = expected_faces(&m, &id, &[4.0; 4], l);
+        assert!((got4 - 4.0 * want).abs() < 1e-9 * want, "{got4}");
+    }
+}

@@ -1,0 +1,453 @@
+//! One patch of Algorithm 1: stages (b)–(e) for a disk patch, certified, with the retry
+//! ladder around them.
+//!
+//! [`patch_step`] tries the patch; an attempt whose parameterization, planar remesh or lifted
+//! faces fail their certificates is not accepted: the patch is shrunk (by the strategy,
+//! [`crate::patches::PatchStrategy::shrink`]) to a smaller disk around an unprocessed face and
+//! tried again, down to [`MIN_PATCH_FACES`], which are then kept as they are. Either way every
+//! face that enters the working mesh is certified and the unprocessed count strictly
+//! decreases (termination).
+
+use super::context::{Counters, LoopState, RunContext};
+use super::debug::{write_candidate, write_debug};
+use super::error::{PipelineError, Stage, StageError};
+use super::records::{FailedAttempt, PatchRecord};
+use crate::fidelity::{self, Refined, RoundOutput, RoundsSetup, VertexFactors};
+use crate::ids::{FaceId, PatchId};
+use crate::invariants::{self, InvariantError};
+use crate::lift::{lift, PatchFrame};
+use crate::mesh::{PlanarDomain, Topology};
+use crate::param::DistortionReport;
+use crate::patches::{extract_patch, interior_corner, interior_feature, Patch, PatchMesh};
+use crate::remesh2d::{pullback_corners, transfer_metric, PlanarMetricField, TransferMethod};
+use crate::stitch::{Replacement, WorkingMesh};
+use nalgebra::{Matrix2, Matrix3};
+use std::time::Instant;
+
+/// Smallest patch the retry ladder shrinks to before keeping the faces unchanged.
+pub const MIN_PATCH_FACES: usize = 8;
+
+/// What became of a patch.
+pub enum PatchOutcome {
+    /// Remeshed: replace `faces` by the certified candidate.
+    Remeshed {
+        /// The faces the candidate replaces (after any shrinking).
+        faces: Vec<FaceId>,
+        /// The certified candidate and the factors to keep.
+        refined: Refined,
+        /// Its record (retries filled in).
+        record: PatchRecord,
+    },
+    /// Even the smallest attempt failed: `faces` stay as they are, marked processed.
+    Kept {
+        /// The kept faces.
+        faces: Vec<FaceId>,
+        /// Its record.
+        record: PatchRecord,
+    },
+}
+
+/// One patch through stages (b)–(e) with the retry ladder (module docs). The working mesh
+/// is not changed; the counters and the retry log are.
+pub fn patch_step(
+    ctx: &RunContext<'_>,
+    state: &mut LoopState,
+    patch: &Patch,
+    rng: &mut crate::Rng,
+) -> Result<PatchOutcome, PipelineError> {
+    let pid = PatchId::new(state.patches);
+    let seed = patch.seed_vertex;
+    let failures_before = state.fallbacks.failures.len();
+    let mut faces = patch.faces.clone();
+    let mut outcome = loop {
+        let unprocessed_in = faces
+            .iter()
+            .filter(|f| !state.work.processed[f.idx()])
+            .count();
+        if unprocessed_in == 0 {
+            return Err(PipelineError::NoProgress { patch: pid, seed });
+        }
+        certify_patch(ctx, state, pid, patch, &faces)?;
+        let record = |faces_out: usize, kept: bool, distortion, fidelity_rounds: usize| PatchRecord {
+            id: pid,
+            seed,
+            faces_in: faces.len(),
+            unprocessed_in,
+            faces_out,
+            cone_angle_deg: patch.cone.filter(|_| !kept).map(|c| c.angle.to_degrees()),
+            distortion,
+            retries: 0,
+            kept,
+            fidelity_rounds,
+        };
+        let view = PatchView {
+            work: &state.work,
+            topo: &state.topo,
+            factors: &state.factors,
+        };
+        match attempt(ctx, &view, &faces, rng, &mut state.counters) {
+            Ok((refined, distortion)) => {
+                let record = record(
+                    refined.replacement.triangles.len(),
+                    false,
+                    distortion,
+                    refined.rounds,
+                );
+                break PatchOutcome::Remeshed {
+                    faces,
+                    refined,
+                    record,
+                };
+            }
+            Err(failure) => {
+                if ctx.plan.options.strict {
+                    return Err(failure.into_error(ctx, pid, patch, &state.work, &faces));
+                }
+                state.fallbacks.failures.push(FailedAttempt {
+                    patch: pid,
+                    faces: faces.len(),
+                    stage: failure.stage,
+                    error: failure.error,
+                });
+                if faces.len() <= MIN_PATCH_FACES {
+                    state.fallbacks.kept_faces += unprocessed_in;
+                    let record = record(faces.len(), true, DistortionReport::default(), 0);
+                    break PatchOutcome::Kept { faces, record };
+                }
+                state.fallbacks.shrinks += 1;
+                let target = faces.len() / 2;
+                faces = ctx.stages.patches.shrink(
+                    &state.patch_context(ctx),
+                    &faces,
+                    patch.seed_face,
+                    target,
+                );
+            }
+        }
+    };
+    let retries = state.fallbacks.failures.len() - failures_before;
+    match &mut outcome {
+        PatchOutcome::Remeshed { record, .. } | PatchOutcome::Kept { record, .. } => {
+            record.retries = retries
+        }
+    }
+    Ok(outcome)
+}
+
+/// The strategy's contract on one attempt's faces: a disk (the hard certificate: a strategy
+/// or a shrink that returns a non-disk is a bug, not a numerical accident), no corner vertex
+/// and no feature edge inside.
+fn certify_patch(
+    ctx: &RunContext<'_>,
+    state: &mut LoopState,
+    pid: PatchId,
+    patch: &Patch,
+    faces: &[FaceId],
+) -> Result<(), PipelineError> {
+    let seed = patch.seed_vertex;
+    let t0 = Instant::now();
+    invariants::certify_disk(&state.work.mesh, faces).map_err(|e| {
+        PipelineError::Certificate {
+            patch: pid,
+            seed: Some(seed),
+            violation: e,
+            debug_file: write_debug(&ctx.plan.options, pid, "patch", &state.work.mesh, faces),
+        }
+    })?;
+    state.counters.cert.disk += 1;
+    if let Some(vertex) = interior_corner(&state.work.mesh, &state.topo, faces, &ctx.corners) {
+        return Err(PipelineError::CornerInterior {
+            patch: pid,
+            seed,
+            vertex,
+        });
+    }
+    if let Some(edge) = state
+        .feature_edges()
+        .and_then(|fe| interior_feature(&state.work.mesh, faces, fe))
+    {
+        return Err(PipelineError::FeatureInterior {
+            patch: pid,
+            seed,
+            edge,
+        });
+    }
+    state.counters.times.patches += t0.elapsed().as_secs_f64();
+    Ok(())
+}
+
+/// The working mesh as one attempt reads it.
+struct PatchView<'a> {
+    work: &'a WorkingMesh,
+    topo: &'a Topology,
+    factors: &'a VertexFactors,
+}
+
+/// A recoverable failure of one attempt: the stage, its error, and the lifted candidate when
+/// that is what failed (written for inspection in strict runs).
+struct AttemptFailure {
+    stage: Stage,
+    error: StageError,
+    candidate: Option<Box<Replacement>>,
+}
+
+impl AttemptFailure {
+    fn at(stage: Stage) -> impl Fn(StageError) -> AttemptFailure {
+        move |error| AttemptFailure {
+            stage,
+            error,
+            candidate: None,
+        }
+    }
+
+    fn lifted(error: InvariantError, candidate: Replacement) -> AttemptFailure {
+        AttemptFailure {
+            stage: Stage::LiftedFaces,
+            error: error.into(),
+            candidate: Some(Box::new(candidate)),
+        }
+    }
+
+    /// The hard error of a strict run, with the patch (and candidate) written for inspection.
+    fn into_error(
+        self,
+        ctx: &RunContext<'_>,
+        pid: PatchId,
+        patch: &Patch,
+        work: &WorkingMesh,
+        faces: &[FaceId],
+    ) -> PipelineError {
+        let options = &ctx.plan.options;
+        let what = self.stage.to_string();
+        let patch_file = write_debug(options, pid, &what, &work.mesh, faces);
+        let cand = self
+            .candidate
+            .as_ref()
+            .and_then(|c| write_candidate(options, pid, work, c));
+        let seed = patch.seed_vertex;
+        match self.error {
+            StageError::Certificate(violation) => PipelineError::Certificate {
+                patch: pid,
+                seed: Some(seed),
+                violation,
+                debug_file: cand.or(patch_file),
+            },
+            source => PipelineError::Stage {
+                patch: pid,
+                seed: Some(seed),
+                stage: self.stage,
+                source,
+            },
+        }
+    }
+}
+
+/// Stages (b)–(e) of Algorithm 1 for one disk patch of the working mesh: parameterize
+/// (certified bijective), transfer the metric (Eq. 4), remesh in 2D with the boundary fixed
+/// (certified) and lift onto the reference surface, within the fidelity rounds; then certify
+/// the new faces (none degenerate, flipped or intersecting).
+fn attempt(
+    ctx: &RunContext<'_>,
+    view: &PatchView<'_>,
+    faces: &[FaceId],
+    rng: &mut crate::Rng,
+    counters: &mut Counters,
+) -> Result<(Refined, DistortionReport), AttemptFailure> {
+    let disk = extract_patch(&view.work.mesh, faces)
+        .map_err(|e| AttemptFailure::at(Stage::PatchExtraction)(e.into()))?;
+
+    // (b) bijective parameterization, certified (the parameterizer certifies; we check again
+    // because it is a research extension point).
+    let t0 = Instant::now();
+    let param = ctx
+        .stages
+        .parameterizer
+        .parameterize(&disk.mesh, &disk.boundary)
+        .map_err(|e| AttemptFailure::at(Stage::Parameterization)(e.into()))?;
+    invariants::certify_bijective(&param.uv, &disk.mesh.triangles, &disk.boundary)
+        .map_err(|e| AttemptFailure::at(Stage::Parameterization)(e.into()))?;
+    counters.cert.bijective += 1;
+    if param.report.fell_back {
+        counters.cert.param_fallbacks += 1;
+    }
+    counters.times.param += t0.elapsed().as_secs_f64();
+
+    // (c) metric transfer (Eq. 4): the 3D metric at each patch vertex's reference location,
+    // carried to the plane.
+    let t0 = Instant::now();
+    let metrics3d = fidelity::patch_metrics(
+        ctx.field(),
+        &ctx.plan.fid_scale,
+        view.factors,
+        &disk.mesh,
+        &disk.to_global,
+        &view.work.locations,
+    );
+    let transfer = Transferred::new(ctx, &disk, &param.uv, &metrics3d)?;
+    counters.times.transfer += t0.elapsed().as_secs_f64();
+
+    // (d) planar remeshing with the patch boundary fixed, certified, and (e) mapping back,
+    // repeated by the fidelity control while the lifted patch deviates from the reference.
+    let refined = remesh_and_lift(ctx, &disk, &transfer, view.factors, rng, counters)?;
+
+    // The candidate's new faces, certified before the working mesh is touched.
+    let t0 = Instant::now();
+    let checked =
+        invariants::certify_replacement(&ctx.flip_test, view.work, view.topo, faces, &refined.replacement);
+    counters.times.certify += t0.elapsed().as_secs_f64();
+    if let Err(e) = checked {
+        return Err(AttemptFailure::lifted(e, refined.replacement));
+    }
+    counters.cert.no_degenerate += 1;
+    counters.cert.no_flips += 1;
+    if ctx.embedded_input {
+        let t0 = Instant::now();
+        let checked =
+            invariants::certify_candidate_embedded(view.work, faces, &refined.replacement);
+        counters.times.certify += t0.elapsed().as_secs_f64();
+        if let Err(e) = checked {
+            return Err(AttemptFailure::lifted(e, refined.replacement));
+        }
+        counters.cert.locally_embedded += 1;
+    }
+    Ok((refined, param.report))
+}
+
+/// The patch in the plane: the parameterization as a planar domain, and the metric carried
+/// onto it.
+struct Transferred {
+    domain: PlanarDomain,
+    metrics: Vec<Matrix2<f64>>,
+    /// Per-triangle corner tensors ([`super::RemeshOptions::corner_pullback`]).
+    corners: Option<Vec<[Matrix2<f64>; 3]>>,
+}
+
+impl Transferred {
+    fn new(
+        ctx: &RunContext<'_>,
+        disk: &PatchMesh,
+        uv: &[nalgebra::Point2<f64>],
+        metrics3d: &[Matrix3<f64>],
+    ) -> Result<Transferred, AttemptFailure> {
+        let o = &ctx.plan.options;
+        let fail = AttemptFailure::at(Stage::MetricTransfer);
+        let metrics = transfer_metric(&disk.mesh, uv, metrics3d, o.transfer)
+            .map_err(|e| fail(e.into()))?;
+        let corners = match o.corner_pullback && o.transfer == TransferMethod::JacobianPullback {
+            true => Some(pullback_corners(&disk.mesh, uv, metrics3d).map_err(|e| fail(e.into()))?),
+            false => None,
+        };
+        let domain = PlanarDomain {
+            points: uv.to_vec(),
+            triangles: disk
+                .mesh
+                .triangles
+                .iter()
+                .map(|t| [t[0].0, t[1].0, t[2].0])
+                .collect(),
+            boundary: disk.boundary.iter().map(|v| v.0).collect(),
+            constrained_edges: Vec::new(),
+        };
+        Ok(Transferred {
+            domain,
+            metrics,
+            corners,
+        })
+    }
+
+    /// The planar metric field of one round: the (possibly scaled) vertex tensors and, with
+    /// corner tensors, those scaled by the same factor (the ratio of traces).
+    fn field(
+        &self,
+        metrics: &[Matrix2<f64>],
+        base_trace: &[f64],
+    ) -> Result<PlanarMetricField, StageError> {
+        let d = &self.domain;
+        let field = PlanarMetricField::new(d.points.clone(), d.triangles.clone(), metrics.to_vec())?;
+        let Some(c) = &self.corners else {
+            return Ok(field);
+        };
+        let factor: Vec<f64> = metrics
+            .iter()
+            .zip(base_trace)
+            .map(|(m, b)| if *b > 0.0 { m.trace() / b } else { 1.0 })
+            .collect();
+        let scaled = c
+            .iter()
+            .zip(&d.triangles)
+            .map(|(c, t)| [0, 1, 2].map(|k| c[k] * factor[t[k] as usize]))
+            .collect();
+        Ok(field.with_corner_metrics(scaled)?)
+    }
+}
+
+/// Stages (d) and (e) inside the fidelity rounds ([`fidelity::refine`]): each round remeshes
+/// the domain in the plane (certified) and lifts it by barycentric location in the initial 2D
+/// mesh, projected onto the reference.
+fn remesh_and_lift(
+    ctx: &RunContext<'_>,
+    disk: &PatchMesh,
+    transfer: &Transferred,
+    carried: &VertexFactors,
+    rng: &mut crate::Rng,
+    counters: &mut Counters,
+) -> Result<Refined, AttemptFailure> {
+    let field = ctx.field();
+    let setup = RoundsSetup {
+        options: &ctx.plan.options.fidelity,
+        field,
+        normals: &ctx.ref_normals,
+        l_tar: ctx.plan.l_tar,
+        min_edge: ctx.plan.min_edge,
+    };
+    let frame = PatchFrame {
+        triangles: &disk.mesh.triangles,
+        positions: &disk.mesh.positions,
+        to_global: &disk.to_global,
+    };
+    let base_trace: Vec<f64> = transfer.metrics.iter().map(|m| m.trace()).collect();
+    let mut clock = 0.0;
+    let refined = fidelity::refine(
+        &setup,
+        &disk.mesh.positions,
+        &disk.to_global,
+        carried,
+        transfer.metrics.clone(),
+        &mut clock,
+        |metrics, round| {
+            let t0 = Instant::now();
+            let planar_field = transfer
+                .field(metrics, &base_trace)
+                .map_err(AttemptFailure::at(Stage::MetricTransfer))?;
+            let planar = ctx
+                .stages
+                .remesher
+                .remesh(&transfer.domain, &planar_field, ctx.plan.l_tar, rng)
+                .map_err(|e| AttemptFailure::at(Stage::PlanarRemeshing)(e.into()))?;
+            invariants::certify_planar(&transfer.domain, &planar)
+                .map_err(|e| AttemptFailure::at(Stage::PlanarRemeshing)(e.into()))?;
+            match round {
+                0 => counters.cert.planar += 1,
+                _ => counters.cert.planar_refined += 1,
+            }
+            counters.times.remesh2d += t0.elapsed().as_secs_f64();
+            let t0 = Instant::now();
+            let replacement = lift(
+                &planar,
+                &frame,
+                |p| planar_field.locate(p),
+                |p| field.project(p).0,
+                field.reference(),
+            )
+            .map_err(|e| AttemptFailure::at(Stage::MappingBack)(e.into()))?;
+            counters.times.lift += t0.elapsed().as_secs_f64();
+            Ok(RoundOutput {
+                planar,
+                field: planar_field,
+                replacement,
+            })
+        },
+    );
+    counters.times.fidelity += clock;
+    refined
+}

@@ -1,0 +1,63 @@
+//! The registry of planar remeshers: name → constructor and options. A new remesher is a
+//! new file in `remesh2d/` plus one row here.
+
+use super::{Lct, LctOptions, PlanarRemesher};
+use crate::registry::{BadValue, Entry, OptionDoc, Params, RegistryError};
+
+/// Every built-in planar remesher, the default first.
+pub static REMESHERS: &[Entry<dyn PlanarRemesher>] = &[Entry {
+    name: "lct",
+    summary: "anisotropic meshing with local convex functions (ref. [5], Sec. 3.3), the paper's",
+    options: &[
+        OptionDoc {
+            name: "rounds",
+            doc: "outer rounds of split/collapse, flips and smoothing [8]",
+        },
+        OptionDoc {
+            name: "split_ratio",
+            doc: "split interior edges longer than this times L_tar [4/3]",
+        },
+        OptionDoc {
+            name: "collapse_ratio",
+            doc: "collapse interior edges shorter than this times L_tar [4/5]",
+        },
+        OptionDoc {
+            name: "smoothing_iters",
+            doc: "smoothing passes per round, each followed by flips [3]",
+        },
+        OptionDoc {
+            name: "final_smoothing",
+            doc: "final polish passes (equilateral-apex smoothing + flips) [6]",
+        },
+    ],
+    build: lct,
+}];
+
+/// The planar remesher of row `name` with `params` (see [`REMESHERS`]).
+pub fn planar_remesher(
+    name: &str,
+    params: Params,
+) -> Result<Box<dyn PlanarRemesher>, RegistryError> {
+    crate::registry::build("planar remesher", REMESHERS, name, params)
+}
+
+fn lct(p: &mut Params) -> Result<Box<dyn PlanarRemesher>, BadValue> {
+    let mut o = LctOptions::default();
+    let ratio = |x: f64| x.is_finite() && x > 0.0;
+    if let Some(r) = p.take("rounds", "a number of rounds")? {
+        o.rounds = r;
+    }
+    if let Some(r) = p.take_checked("split_ratio", "a number above 1", |x: f64| ratio(x) && x > 1.0)? {
+        o.split_ratio = r;
+    }
+    if let Some(r) = p.take_checked("collapse_ratio", "a number in (0, 1)", |x: f64| ratio(x) && x < 1.0)? {
+        o.collapse_ratio = r;
+    }
+    if let Some(n) = p.take("smoothing_iters", "a number of passes")? {
+        o.smoothing_iters = n;
+    }
+    if let Some(n) = p.take("final_smoothing", "a number of passes")? {
+        o.final_smoothing = n;
+    }
+    Ok(Box::new(Lct { options: o }))
+}
