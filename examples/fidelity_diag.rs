@@ -2,8 +2,8 @@
 //! points of each side with the local curvature (5-ring and 2-ring fits) and crease angle of the
 //! input there. `cargo run --release --example fidelity_diag -- INPUT OUTPUT [N]`.
 
-use conemesh::metric::{principal_curvatures, CurvatureOptions, Normalization};
 use conemesh::mesh::SurfaceProjector;
+use conemesh::metric::{principal_curvatures, CurvatureOptions, Normalization};
 use conemesh::{FaceId, TriMesh};
 use nalgebra::Point3;
 

@@ -4,9 +4,9 @@
 //! another patch), faces near an input self-intersection, faces of shrunk (retried) patches,
 //! and the rest. `cargo run --release --example quality_diag -- MESH [radius]`.
 
+use conemesh::mesh::SurfaceProjector;
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
 use conemesh::pipeline::{remesh, RemeshOptions, Stages};
-use conemesh::mesh::SurfaceProjector;
 use conemesh::quality::face_qualities;
 use conemesh::{EdgeKey, FaceId, TriMesh};
 use nalgebra::Point3;

@@ -10,7 +10,9 @@ use conemesh::mesh::{generators, Topology, TriMesh};
 use conemesh::param::PARAMETERIZERS;
 use conemesh::patches::{corner_vertices, extract_patch, STRATEGIES};
 use conemesh::registry::Params;
-use conemesh::remesh2d::{resample_polygon, triangulate_polygon, DemoDomain, DemoMetric, REMESHERS};
+use conemesh::remesh2d::{
+    resample_polygon, triangulate_polygon, DemoDomain, DemoMetric, REMESHERS,
+};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use std::collections::HashSet;

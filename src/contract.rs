@@ -105,14 +105,19 @@ pub fn patch_strategy(
         let Some(patch) = got else {
             return match unprocessed {
                 0 => Ok(patches),
-                n => Err(broken(format!("returned no patch with {n} faces unprocessed"))),
+                n => Err(broken(format!(
+                    "returned no patch with {n} faces unprocessed"
+                ))),
             };
         };
         if unprocessed == 0 {
             return Err(broken("returned a patch with every face processed".into()));
         }
         if patches > case.mesh.n_faces() {
-            return Err(broken(format!("{patches} patches for {} faces", case.mesh.n_faces())));
+            return Err(broken(format!(
+                "{patches} patches for {} faces",
+                case.mesh.n_faces()
+            )));
         }
         let boundary = check_patch_faces(name, &ctx, &patch.faces)?;
         if !same_loop(&boundary, &patch.boundary) {
@@ -168,12 +173,13 @@ fn check_patch_faces(
     if faces.iter().all(|f| ctx.processed[f.idx()]) {
         return Err(broken("a patch without an unprocessed face".into()));
     }
-    let boundary =
-        invariants::certify_disk(ctx.mesh, faces).map_err(|violation| ContractViolation::Certificate {
+    let boundary = invariants::certify_disk(ctx.mesh, faces).map_err(|violation| {
+        ContractViolation::Certificate {
             name,
             what: "patch is a disk",
             violation,
-        })?;
+        }
+    })?;
     if let Some(v) = ctx
         .corners
         .and_then(|c| interior_corner(ctx.mesh, ctx.topology, faces, c))
@@ -223,7 +229,11 @@ pub fn parameterizer(
             disk.n_vertices()
         )));
     }
-    if let Some(i) = map.uv.iter().position(|p| !(p.x.is_finite() && p.y.is_finite())) {
+    if let Some(i) = map
+        .uv
+        .iter()
+        .position(|p| !(p.x.is_finite() && p.y.is_finite()))
+    {
         return Err(broken(format!("the point of v{i} is not finite")));
     }
     invariants::certify_bijective(&map.uv, &disk.triangles, boundary).map_err(|violation| {
@@ -233,10 +243,12 @@ pub fn parameterizer(
             violation,
         }
     })?;
-    let again = param.parameterize(disk, boundary).map_err(|e| ContractViolation::Failed {
-        name,
-        message: e.to_string(),
-    })?;
+    let again = param
+        .parameterize(disk, boundary)
+        .map_err(|e| ContractViolation::Failed {
+            name,
+            message: e.to_string(),
+        })?;
     if again.uv != map.uv {
         return Err(broken("a second call gave a different map".into()));
     }
@@ -336,10 +348,7 @@ mod tests {
         };
         // The first patch (the whole disk) is fine; the second has no unprocessed face.
         let e = patch_strategy(&Greedy, &case).expect_err("a broken strategy");
-        assert!(
-            e.to_string().contains("every face processed"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("every face processed"), "{e}");
         // On a torus the whole mesh is not a disk.
         let torus = generators::torus(1.0, 0.4, 12, 6);
         let case = StrategyCase {
@@ -389,7 +398,7 @@ mod tests {
     #[test]
     fn the_checks_catch_a_broken_remesher() {
         use crate::mesh::PlanarMesh;
-        use crate::remesh2d::{Remesh2dError, DemoMetric};
+        use crate::remesh2d::{DemoMetric, Remesh2dError};
         struct Dropper;
         impl PlanarRemesher for Dropper {
             fn name(&self) -> &'static str {

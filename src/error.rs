@@ -36,6 +36,12 @@ pub enum Error {
     /// Replacing a patch in the working mesh.
     #[error(transparent)]
     Stitch(#[from] crate::stitch::StitchError),
+    /// Scoring a remeshed surface (`conemesh eval`).
+    #[error(transparent)]
+    Eval(#[from] crate::quality::EvalError),
+    /// Building a registered extension-point implementation.
+    #[error(transparent)]
+    Registry(#[from] crate::registry::RegistryError),
     /// Algorithm 1.
     #[error(transparent)]
     Pipeline(#[from] crate::pipeline::PipelineError),

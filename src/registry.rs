@@ -167,14 +167,15 @@ pub fn build<T: ?Sized>(
     name: &str,
     mut params: Params,
 ) -> Result<Box<T>, RegistryError> {
-    let entry = table
-        .iter()
-        .find(|e| e.name == name)
-        .ok_or_else(|| RegistryError::UnknownName {
-            kind,
-            name: name.to_string(),
-            known: names(table).join(", "),
-        })?;
+    let entry =
+        table
+            .iter()
+            .find(|e| e.name == name)
+            .ok_or_else(|| RegistryError::UnknownName {
+                kind,
+                name: name.to_string(),
+                known: names(table).join(", "),
+            })?;
     let built = (entry.build)(&mut params).map_err(|b| RegistryError::BadValue {
         kind,
         name: entry.name,

@@ -4,10 +4,10 @@
 //! angle is refused by name. Release only for the shared mesh (fandisk).
 
 use conemesh::features::sharp_edges;
+use conemesh::mesh::SurfaceProjector;
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
 use conemesh::patches::{Patch, PatchContext, PatchError, PatchStrategy};
 use conemesh::pipeline::{remesh, PipelineError, RemeshOptions, Stages};
-use conemesh::mesh::SurfaceProjector;
 use conemesh::quality::{evaluate, EvalOptions};
 use conemesh::{mesh::generators, Topology, TriMesh};
 use nalgebra::Point3;

@@ -145,6 +145,18 @@ pub fn deviations(
         .collect()
 }
 
+/// The bounds of [`scale_metric`].
+#[derive(Copy, Clone, Debug)]
+pub struct ScaleLimits {
+    /// The tolerance the deviations are measured against.
+    pub eps: f64,
+    /// Largest factor of one round.
+    pub max_factor: f64,
+    /// Target metric edge length.
+    pub l_tar: f64,
+    /// No tensor is scaled beyond a shortest edge `l_tar/√λ_max` of this length.
+    pub min_edge: f64,
+}
 
 /// Scale the transferred metric (one tensor per vertex of the initial 2D mesh) up around the
 /// deviating triangles of `planar`: the vertices of the initial triangles under a deviating
@@ -153,17 +165,19 @@ pub fn deviations(
 /// sagitta quadratically; the square covers both), capped at `max_factor`; their neighbours
 /// in the initial mesh get its square root, a one-ring gradation. No tensor is scaled beyond
 /// a shortest edge `l_tar/√λ_max` of `min_edge`. Returns how many tensors were scaled.
-#[allow(clippy::too_many_arguments)]
 pub fn scale_metric(
     metrics: &mut [Matrix2<f64>],
     field: &PlanarMetricField,
     planar: &PlanarMesh,
     deviating: &[(usize, f64)],
-    eps: f64,
-    max_factor: f64,
-    l_tar: f64,
-    min_edge: f64,
+    limits: &ScaleLimits,
 ) -> usize {
+    let ScaleLimits {
+        eps,
+        max_factor,
+        l_tar,
+        min_edge,
+    } = *limits;
     let mut factor = vec![1.0f64; metrics.len()];
     let init = field.triangles();
     for &(t, d) in deviating {

@@ -24,9 +24,10 @@ mod rounds;
 mod tests;
 
 pub use apriori::a_priori_scale;
-pub use measure::{deviations, patch_vertex_factors, scale_metric, LiftedPatch};
+pub use measure::{deviations, patch_vertex_factors, scale_metric, LiftedPatch, ScaleLimits};
 pub use rounds::{
-    patch_metrics, refine, PatchFactors, Refined, RoundOutput, RoundsSetup, VertexFactors,
+    patch_metrics, refine, PatchFactors, PatchVertices, Refined, RoundOutput, RoundsSetup,
+    VertexFactors,
 };
 
 use serde::Serialize;

@@ -3,7 +3,7 @@
 //! where the lifted patch deviates from the reference ([`refine`]), and the per-vertex factors
 //! kept between patches ([`VertexFactors`]).
 
-use super::measure::{deviations, patch_vertex_factors, scale_metric, LiftedPatch};
+use super::measure::{deviations, patch_vertex_factors, scale_metric, LiftedPatch, ScaleLimits};
 use super::FidelityOptions;
 use crate::ids::VertexId;
 use crate::mesh::{PlanarMesh, SurfaceLocation, TriMesh};
@@ -149,23 +149,35 @@ pub struct Refined {
     pub factors: PatchFactors,
 }
 
+/// The vertices of a patch's initial 2D mesh: 3D positions and working-mesh ids.
+#[derive(Copy, Clone)]
+pub struct PatchVertices<'a> {
+    /// 3D position of each.
+    pub positions: &'a [Point3<f64>],
+    /// Working-mesh id of each.
+    pub to_global: &'a [VertexId],
+}
+
 /// The fidelity rounds of one patch (our addition; paper-notes.md "Fidelity control"):
 /// `round(metrics, k)` remeshes the patch in the plane in `metrics` (one tensor per vertex of
-/// the initial 2D mesh, whose 3D positions are `positions` and working-mesh ids `to_global`)
+/// the initial 2D mesh, `vertices`)
 /// and lifts it; while the lifted candidate deviates from the reference by more than the
 /// tolerance (at most [`FidelityOptions::rounds`] times), the metric is scaled up around the
 /// deviating triangles ([`scale_metric`]) and the patch remeshed again. `clock` accumulates
 /// the time of the measurements.
 pub fn refine<E>(
     setup: &RoundsSetup<'_>,
-    positions: &[Point3<f64>],
-    to_global: &[VertexId],
+    vertices: PatchVertices<'_>,
     carried: &VertexFactors,
     mut metrics: Vec<Matrix2<f64>>,
     clock: &mut f64,
     mut round: impl FnMut(&[Matrix2<f64>], usize) -> Result<RoundOutput, E>,
 ) -> Result<Refined, E> {
     let o = setup.options;
+    let PatchVertices {
+        positions,
+        to_global,
+    } = vertices;
     let base_trace: Vec<f64> = metrics.iter().map(|m| m.trace()).collect();
     let mut rounds = 0usize;
     loop {
@@ -213,10 +225,12 @@ pub fn refine<E>(
                 &out.field,
                 &out.planar,
                 &deviating,
-                eps,
-                o.max_factor,
-                setup.l_tar,
-                setup.min_edge,
+                &ScaleLimits {
+                    eps,
+                    max_factor: o.max_factor,
+                    l_tar: setup.l_tar,
+                    min_edge: setup.min_edge,
+                },
             ),
         };
         *clock += t0.elapsed().as_secs_f64();

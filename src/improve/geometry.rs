@@ -64,7 +64,12 @@ pub(crate) fn point_triangle_distance(p: &Point3<f64>, t: &[Point3<f64>; 3]) -> 
 
 /// Distance between the segments `ab` and `cd` (sampled closest-point iteration is not
 /// needed: the exact minimum over the clamped parameters).
-pub(crate) fn segment_distance(a: Point3<f64>, b: Point3<f64>, c: Point3<f64>, d: Point3<f64>) -> f64 {
+pub(crate) fn segment_distance(
+    a: Point3<f64>,
+    b: Point3<f64>,
+    c: Point3<f64>,
+    d: Point3<f64>,
+) -> f64 {
     let (u, v, w) = (b - a, d - c, a - c);
     let (aa, bb, cc, dd, ee) = (u.dot(&u), u.dot(&v), v.dot(&v), u.dot(&w), v.dot(&w));
     let den = aa * cc - bb * bb;

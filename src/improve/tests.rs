@@ -36,8 +36,8 @@ fn rhombus(lift: f64) -> (MetricField, WorkingMesh, FlipTest) {
             [VertexId(1), VertexId(0), VertexId(3)],
         ],
     };
-    let field = MetricField::new(reference.clone(), vec![Matrix3::identity(); 4])
-        .expect("identity metric");
+    let field =
+        MetricField::new(reference.clone(), vec![Matrix3::identity(); 4]).expect("identity metric");
     let work = WorkingMesh::from_reference(&reference);
     let flip_test = FlipTest::new(&reference);
     (field, work, flip_test)
@@ -128,7 +128,10 @@ fn flip_pass_keeps_a_ridge_beyond_the_tolerance() {
     );
     assert_eq!(work.mesh.triangles, before);
     // With a tolerance above the ridge height the same flip is made.
-    assert_eq!(connectivity_update(&ctx(&field, &flip_test, 0.1, None), &mut work), 1);
+    assert_eq!(
+        connectivity_update(&ctx(&field, &flip_test, 0.1, None), &mut work),
+        1
+    );
 }
 
 /// A flat hexagonal fan whose centre sits near one corner: relocation moves it towards

@@ -398,7 +398,6 @@ fn key(p: &Point3<f64>) -> [u64; 3] {
     ]
 }
 
-
 /// The boundary edges of `mesh` (edges with one face), by vertex ids.
 pub fn boundary_edges(topo: &Topology) -> Vec<EdgeKey> {
     topo.edges()

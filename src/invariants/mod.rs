@@ -10,10 +10,10 @@
 pub mod mesh;
 
 pub use mesh::{
-    boundary_edges, certify_boundary_kept, certify_boundary_preserved, certify_manifold, certify_manifold_at, certify_no_degenerate_faces,
-    certify_no_self_intersections, certify_oriented, certify_same_topology, degenerate_faces,
-    faces_intersect, is_degenerate, non_manifold_vertices, non_manifold_vertices_among,
-    self_intersections, TopologySignature,
+    boundary_edges, certify_boundary_kept, certify_boundary_preserved, certify_manifold,
+    certify_manifold_at, certify_no_degenerate_faces, certify_no_self_intersections,
+    certify_oriented, certify_same_topology, degenerate_faces, faces_intersect, is_degenerate,
+    non_manifold_vertices, non_manifold_vertices_among, self_intersections, TopologySignature,
 };
 
 use crate::ids::{EdgeKey, FaceId, VertexId};

@@ -2,8 +2,8 @@
 //! input polygon, with the boundary loop and constrained edges kept bit for bit.
 
 use super::InvariantError;
-use crate::predicates::{orient2d, Sign};
 use crate::mesh::{PlanarDomain, PlanarMesh};
+use crate::predicates::{orient2d, Sign};
 use nalgebra::Point2;
 use std::collections::HashMap;
 

@@ -2,8 +2,8 @@
 //! point-triangle projection (the distance to the triangle, not to its vertices). Used by
 //! the distance measures, the flip certificate and the fidelity control.
 
-use crate::ids::FaceId;
 use super::TriMesh;
+use crate::ids::FaceId;
 use nalgebra::Point3;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::PointQueryWithLocation;
@@ -45,10 +45,7 @@ impl SurfaceProjector {
 
 /// parry's triangle mesh (with its BVH) over `positions` and `triangles`; `None` without
 /// triangles or when parry refuses them.
-pub fn parry_trimesh(
-    positions: &[Point3<f64>],
-    triangles: Vec<[u32; 3]>,
-) -> Option<PTriMesh> {
+pub fn parry_trimesh(positions: &[Point3<f64>], triangles: Vec<[u32; 3]>) -> Option<PTriMesh> {
     if triangles.is_empty() {
         return None;
     }

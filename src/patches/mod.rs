@@ -220,8 +220,6 @@ pub fn interior_feature(
         .min()
 }
 
-
-
 #[cfg(test)]
 mod tests {
     use super::*;

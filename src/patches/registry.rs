@@ -65,7 +65,9 @@ fn positive(x: f64) -> bool {
 
 fn cone(p: &mut Params) -> Result<Box<dyn PatchStrategy>, BadValue> {
     let mut o = ConeOptions::default();
-    if let Some(b) = p.take_checked("beta", "a finite number ≥ 0", |b: f64| b.is_finite() && b >= 0.0)? {
+    if let Some(b) = p.take_checked("beta", "a finite number ≥ 0", |b: f64| {
+        b.is_finite() && b >= 0.0
+    })? {
         o.beta = b;
     }
     if let Some(c) = p.take_checked("c_max", "a positive number", positive)? {

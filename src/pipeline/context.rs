@@ -147,8 +147,7 @@ impl LoopState {
         .map_err(|e| PipelineError::Input(e.to_string()))?;
         let pinned = (0..work.mesh.n_vertices())
             .map(|v| {
-                ctx.corners.get(v).copied().unwrap_or(false)
-                    || features.is_pinned(VertexId::new(v))
+                ctx.corners.get(v).copied().unwrap_or(false) || features.is_pinned(VertexId::new(v))
             })
             .collect();
         let topo = match work.mesh.n_faces() == reference.n_faces() {

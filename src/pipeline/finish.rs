@@ -25,17 +25,23 @@ pub fn improve(ctx: &RunContext<'_>, state: &mut LoopState) -> PassCounts {
         field: ctx.quality_field,
         flip_test: &ctx.flip_test,
         embedded_input: ctx.embedded_input,
-        tol: if ctx.plan.eps > 0.0 {
-            ctx.plan.eps
-        } else {
-            f64::INFINITY
-        },
+        tol: passes_tolerance(ctx.plan.eps),
         feature_edges: (!state.features.edges.is_empty()).then_some(&state.features.edges),
         pinned: &state.pinned,
     };
     let counts = finishing_passes(&surface, &mut state.work, o.edge_flips, o.relocate);
     state.counters.times.certify += t0.elapsed().as_secs_f64();
     counts
+}
+
+/// How far the surface passes may move the surface: the fidelity tolerance, or no bound when
+/// the control is off (`--hausd 0`: the metric alone decides, as in the paper).
+fn passes_tolerance(eps: f64) -> f64 {
+    if eps > 0.0 {
+        eps
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// The certificates of the whole output: the working mesh once more (the per-patch manifold
@@ -94,9 +100,9 @@ fn certify_corners(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), Pipeli
         .iter()
         .flatten()
         .for_each(|v| used[v.idx()] = true);
-    match (0..ctx.corners.len()).find(|&v| {
-        ctx.corners[v] && (!used[v] || mesh.positions[v] != reference.positions[v])
-    }) {
+    match (0..ctx.corners.len())
+        .find(|&v| ctx.corners[v] && (!used[v] || mesh.positions[v] != reference.positions[v]))
+    {
         Some(v) => Err(PipelineError::CornerLost(VertexId::new(v))),
         None => Ok(()),
     }
@@ -183,5 +189,16 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -
         locations: state.work.locations,
         face_patch: state.face_patch,
         report,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// With the distance control off the passes are not bounded by the default tolerance
+    /// (they were before the house issue); with it on they use exactly the tolerance.
+    #[test]
+    fn passes_use_the_runs_tolerance() {
+        assert_eq!(super::passes_tolerance(0.0), f64::INFINITY);
+        assert_eq!(super::passes_tolerance(0.002), 0.002);
     }
 }

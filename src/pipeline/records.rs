@@ -192,18 +192,27 @@ pub enum Warning {
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Warning::FailedAttempts { attempts, kept_faces } => write!(
+            Warning::FailedAttempts {
+                attempts,
+                kept_faces,
+            } => write!(
                 f,
                 "{attempts} patch attempt(s) failed their certificates and were retried smaller; \
                  {kept_faces} face(s) (of the input, or of an earlier sweep) could not be remeshed \
                  and were kept as they were (details: --report, `fallbacks`)"
             ),
-            Warning::PatchBudget { patches, unprocessed } => write!(
+            Warning::PatchBudget {
+                patches,
+                unprocessed,
+            } => write!(
                 f,
                 "the patch budget ran out after {patches} patches: {unprocessed} face(s) were \
                  not reached and are kept as they were"
             ),
-            Warning::InputSelfIntersects { input_pairs, output_pairs } => write!(
+            Warning::InputSelfIntersects {
+                input_pairs,
+                output_pairs,
+            } => write!(
                 f,
                 "the input itself self-intersects ({input_pairs} face pairs); the output, which \
                  lies on it, has {output_pairs}"

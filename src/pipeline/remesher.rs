@@ -124,11 +124,20 @@ impl Remesher {
             kept
         });
         let field = match &input_metric {
-            Some(m) => MetricField::new(reference, m.iter().map(|m| norm.metric_to_unit(m)).collect())?,
+            Some(m) => MetricField::new(
+                reference,
+                m.iter().map(|m| norm.metric_to_unit(m)).collect(),
+            )?,
             None => MetricField::from_curvature(reference, &self.metric)?,
         };
         let unit = super::remesh(&field, &self.stages, &self.options, on_progress)?;
-        let mesh = to_file_units(&unit.mesh, &unit.locations, field.reference(), &file_mesh, &norm);
+        let mesh = to_file_units(
+            &unit.mesh,
+            &unit.locations,
+            field.reference(),
+            &file_mesh,
+            &norm,
+        );
         // The certificates were taken in unit space; mapping back to file units rounds the new
         // vertices, so the mesh that is returned is certified again (exact): no degenerate
         // face, and no self-intersection where the unit-space output had none.

@@ -55,7 +55,12 @@ pub fn replace_patch(
                         StageError::FactorCount { factors, vertices },
                     )
                 })?;
-            follow_provenance(&mut state.face_patch, &faces, state.work.mesh.n_faces(), pid);
+            follow_provenance(
+                &mut state.face_patch,
+                &faces,
+                state.work.mesh.n_faces(),
+                pid,
+            );
             (new_faces, record, touched)
         }
         PatchOutcome::Kept { faces, record } => {

@@ -142,7 +142,14 @@ fn a_priori(
     let min_edge = o.fidelity.min_edge_ratio * if n == 0 { 0.0 } else { sum / n as f64 };
     let eps = o.fidelity.max_deviation;
     let fid_scale = if eps > 0.0 {
-        fidelity::a_priori_scale(reference, topo, field.vertex_metrics(), l_tar, eps, min_edge)
+        fidelity::a_priori_scale(
+            reference,
+            topo,
+            field.vertex_metrics(),
+            l_tar,
+            eps,
+            min_edge,
+        )
     } else {
         Vec::new()
     };

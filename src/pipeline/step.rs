@@ -12,7 +12,7 @@ use super::context::{Counters, LoopState, RunContext};
 use super::debug::{write_candidate, write_debug};
 use super::error::{PipelineError, Stage, StageError};
 use super::records::{FailedAttempt, PatchRecord};
-use crate::fidelity::{self, Refined, RoundOutput, RoundsSetup, VertexFactors};
+use crate::fidelity::{self, PatchVertices, Refined, RoundOutput, RoundsSetup, VertexFactors};
 use crate::ids::{FaceId, PatchId};
 use crate::invariants::{self, InvariantError};
 use crate::lift::{lift, PatchFrame};
@@ -68,18 +68,19 @@ pub fn patch_step(
             return Err(PipelineError::NoProgress { patch: pid, seed });
         }
         certify_patch(ctx, state, pid, patch, &faces)?;
-        let record = |faces_out: usize, kept: bool, distortion, fidelity_rounds: usize| PatchRecord {
-            id: pid,
-            seed,
-            faces_in: faces.len(),
-            unprocessed_in,
-            faces_out,
-            cone_angle_deg: patch.cone.filter(|_| !kept).map(|c| c.angle.to_degrees()),
-            distortion,
-            retries: 0,
-            kept,
-            fidelity_rounds,
-        };
+        let record =
+            |faces_out: usize, kept: bool, distortion, fidelity_rounds: usize| PatchRecord {
+                id: pid,
+                seed,
+                faces_in: faces.len(),
+                unprocessed_in,
+                faces_out,
+                cone_angle_deg: patch.cone.filter(|_| !kept).map(|c| c.angle.to_degrees()),
+                distortion,
+                retries: 0,
+                kept,
+                fidelity_rounds,
+            };
         let view = PatchView {
             work: &state.work,
             topo: &state.topo,
@@ -146,13 +147,11 @@ fn certify_patch(
 ) -> Result<(), PipelineError> {
     let seed = patch.seed_vertex;
     let t0 = Instant::now();
-    invariants::certify_disk(&state.work.mesh, faces).map_err(|e| {
-        PipelineError::Certificate {
-            patch: pid,
-            seed: Some(seed),
-            violation: e,
-            debug_file: write_debug(&ctx.plan.options, pid, "patch", &state.work.mesh, faces),
-        }
+    invariants::certify_disk(&state.work.mesh, faces).map_err(|e| PipelineError::Certificate {
+        patch: pid,
+        seed: Some(seed),
+        violation: e,
+        debug_file: write_debug(&ctx.plan.options, pid, "patch", &state.work.mesh, faces),
     })?;
     state.counters.cert.disk += 1;
     if let Some(vertex) = interior_corner(&state.work.mesh, &state.topo, faces, &ctx.corners) {
@@ -292,8 +291,13 @@ fn attempt(
 
     // The candidate's new faces, certified before the working mesh is touched.
     let t0 = Instant::now();
-    let checked =
-        invariants::certify_replacement(&ctx.flip_test, view.work, view.topo, faces, &refined.replacement);
+    let checked = invariants::certify_replacement(
+        &ctx.flip_test,
+        view.work,
+        view.topo,
+        faces,
+        &refined.replacement,
+    );
     counters.times.certify += t0.elapsed().as_secs_f64();
     if let Err(e) = checked {
         return Err(AttemptFailure::lifted(e, refined.replacement));
@@ -331,8 +335,8 @@ impl Transferred {
     ) -> Result<Transferred, AttemptFailure> {
         let o = &ctx.plan.options;
         let fail = AttemptFailure::at(Stage::MetricTransfer);
-        let metrics = transfer_metric(&disk.mesh, uv, metrics3d, o.transfer)
-            .map_err(|e| fail(e.into()))?;
+        let metrics =
+            transfer_metric(&disk.mesh, uv, metrics3d, o.transfer).map_err(|e| fail(e.into()))?;
         let corners = match o.corner_pullback && o.transfer == TransferMethod::JacobianPullback {
             true => Some(pullback_corners(&disk.mesh, uv, metrics3d).map_err(|e| fail(e.into()))?),
             false => None,
@@ -363,7 +367,8 @@ impl Transferred {
         base_trace: &[f64],
     ) -> Result<PlanarMetricField, StageError> {
         let d = &self.domain;
-        let field = PlanarMetricField::new(d.points.clone(), d.triangles.clone(), metrics.to_vec())?;
+        let field =
+            PlanarMetricField::new(d.points.clone(), d.triangles.clone(), metrics.to_vec())?;
         let Some(c) = &self.corners else {
             return Ok(field);
         };
@@ -409,8 +414,10 @@ fn remesh_and_lift(
     let mut clock = 0.0;
     let refined = fidelity::refine(
         &setup,
-        &disk.mesh.positions,
-        &disk.to_global,
+        PatchVertices {
+            positions: &disk.mesh.positions,
+            to_global: &disk.to_global,
+        },
         carried,
         transfer.metrics.clone(),
         &mut clock,

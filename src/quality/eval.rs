@@ -130,6 +130,14 @@ pub struct EvalReport {
     pub timings: EvalTimings,
 }
 
+/// Errors of [`evaluate`].
+#[derive(Debug, thiserror::Error)]
+pub enum EvalError {
+    /// The metric (a user metric that is not SPD on the input, or the curvature estimate).
+    #[error(transparent)]
+    Metric(#[from] crate::metric::MetricError),
+}
+
 /// Score `output` against `input` (both in file units).
 ///
 /// `input_metric`: per-input-vertex tensors in file units (e.g. read from a `.sol` file);
@@ -139,7 +147,7 @@ pub fn evaluate(
     output: &TriMesh,
     input_metric: Option<&[Matrix3<f64>]>,
     opts: &EvalOptions,
-) -> crate::Result<EvalReport> {
+) -> Result<EvalReport, EvalError> {
     let norm = Normalization::of(input);
     let (unit_in, unit_out) = (norm.apply(input), norm.apply(output));
 

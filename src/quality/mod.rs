@@ -12,7 +12,7 @@ mod distance;
 mod eval;
 
 pub use distance::{approximation_error, flips, Distance};
-pub use eval::{evaluate, EvalOptions, EvalReport, EvalTimings, MeshSize, TargetLength};
+pub use eval::{evaluate, EvalError, EvalOptions, EvalReport, EvalTimings, MeshSize, TargetLength};
 
 use crate::ids::{EdgeKey, VertexId};
 use crate::mesh::TriMesh;

@@ -47,10 +47,14 @@ fn lct(p: &mut Params) -> Result<Box<dyn PlanarRemesher>, BadValue> {
     if let Some(r) = p.take("rounds", "a number of rounds")? {
         o.rounds = r;
     }
-    if let Some(r) = p.take_checked("split_ratio", "a number above 1", |x: f64| ratio(x) && x > 1.0)? {
+    if let Some(r) = p.take_checked("split_ratio", "a number above 1", |x: f64| {
+        ratio(x) && x > 1.0
+    })? {
         o.split_ratio = r;
     }
-    if let Some(r) = p.take_checked("collapse_ratio", "a number in (0, 1)", |x: f64| ratio(x) && x < 1.0)? {
+    if let Some(r) = p.take_checked("collapse_ratio", "a number in (0, 1)", |x: f64| {
+        ratio(x) && x < 1.0
+    })? {
         o.collapse_ratio = r;
     }
     if let Some(n) = p.take("smoothing_iters", "a number of passes")? {
