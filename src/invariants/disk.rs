@@ -8,27 +8,11 @@
 
 use super::InvariantError;
 use crate::ids::{EdgeKey, FaceId, VertexId};
-use crate::mesh::TriMesh;
+use crate::mesh::{TriMesh, UnionFind};
 use std::collections::HashMap;
 
 fn not_disk(reason: String) -> InvariantError {
     InvariantError::NotADisk { reason }
-}
-
-fn find(parent: &mut [usize], mut x: usize) -> usize {
-    while parent[x] != x {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    x
-}
-
-fn union(parent: &mut [usize], a: usize, b: usize) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        let (lo, hi) = (ra.min(rb), ra.max(rb));
-        parent[hi] = lo;
-    }
 }
 
 /// Certify that `faces` of `mesh` form a topological disk and return its boundary loop:
@@ -95,7 +79,7 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
         if fs.len() <= 1 {
             continue;
         }
-        let mut parent: Vec<usize> = (0..fs.len()).collect();
+        let mut sets = UnionFind::new(fs.len());
         for (a, &k) in fs.iter().enumerate() {
             let t = mesh.face(sorted[k]);
             for w in t {
@@ -105,13 +89,13 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
                 for &(_, _, k2) in &edges[&EdgeKey::new(v, w)] {
                     if k2 != k {
                         if let Some(b) = fs.iter().position(|&x| x == k2) {
-                            union(&mut parent, a, b);
+                            sets.union(a, b);
                         }
                     }
                 }
             }
         }
-        let fans = (0..fs.len()).filter(|&i| find(&mut parent, i) == i).count();
+        let fans = sets.count();
         if fans > 1 {
             return Err(not_disk(format!(
                 "vertex {v} is a pinch: its patch faces form {fans} separate fans"
@@ -119,17 +103,15 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
         }
     }
     // Connected through edges.
-    let mut parent: Vec<usize> = (0..sorted.len()).collect();
+    let mut sets = UnionFind::new(sorted.len());
     for key in &keys {
         let hs = &edges[key];
         if hs.len() == 2 {
-            union(&mut parent, hs[0].2, hs[1].2);
+            sets.union(hs[0].2, hs[1].2);
         }
     }
-    if let Some(k) = (0..sorted.len()).find(|&k| find(&mut parent, k) != 0) {
-        let n = (0..sorted.len())
-            .filter(|&i| find(&mut parent, i) == i)
-            .count();
+    if let Some(k) = (0..sorted.len()).find(|&k| sets.find(k) != 0) {
+        let n = sets.count();
         return Err(not_disk(format!(
             "not connected: {n} components (faces {} and {} are not joined through edges)",
             sorted[0], sorted[k]

@@ -6,11 +6,13 @@ pub mod generators;
 pub mod location;
 pub mod planar;
 pub mod topology;
+mod union_find;
 
 pub use closest::{parry_trimesh, SurfaceProjector};
 pub use location::SurfaceLocation;
 pub use planar::{PlanarDomain, PlanarMesh};
 pub use topology::{ComponentInfo, Topology};
+pub use union_find::UnionFind;
 
 use crate::ids::{FaceId, VertexId};
 use nalgebra::{Point3, Vector3};

@@ -9,7 +9,7 @@
 //!
 //! Built by sorting, not hashing, so that every list comes out in a deterministic order.
 
-use super::TriMesh;
+use super::{TriMesh, UnionFind};
 use crate::ids::{EdgeKey, FaceId, HalfedgeId, VertexId};
 use serde::Serialize;
 
@@ -61,24 +61,6 @@ pub struct Topology {
     non_manifold_vertices: std::sync::OnceLock<Vec<VertexId>>,
 }
 
-fn find(parent: &mut [u32], mut x: u32) -> u32 {
-    while parent[x as usize] != x {
-        let p = parent[x as usize];
-        parent[x as usize] = parent[p as usize];
-        x = p;
-    }
-    x
-}
-
-fn union(parent: &mut [u32], a: u32, b: u32) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        // Smaller root wins: labels do not depend on the order of unions.
-        let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-        parent[hi as usize] = lo;
-    }
-}
-
 impl Topology {
     /// Derive the topology. Works on any mesh whose indices are in range (see
     /// [`TriMesh::validate`]); non-manifold and inconsistently oriented parts are recorded,
@@ -120,7 +102,7 @@ impl Topology {
         let mut edge_face_count = Vec::new();
         let mut non_manifold_edges = Vec::new();
         let mut inconsistent_edges = Vec::new();
-        let mut parent: Vec<u32> = (0..nf as u32).collect();
+        let mut sets = UnionFind::new(nf);
         let from = |h: u32| mesh.triangles[(h / 3) as usize][(h % 3) as usize];
         let mut i = 0;
         while i < hes.len() {
@@ -134,7 +116,7 @@ impl Topology {
             edge_face_count.push((j - i) as u32);
             for g in &hes[i..j] {
                 halfedge_edge[g.2 as usize] = e;
-                union(&mut parent, hes[i].2 / 3, g.2 / 3);
+                sets.union((hes[i].2 / 3) as usize, (g.2 / 3) as usize);
             }
             match j - i {
                 1 => {}
@@ -176,7 +158,7 @@ impl Topology {
         let mut root_label = vec![NONE; nf];
         let mut n_comp = 0u32;
         for (f, label) in face_component.iter_mut().enumerate() {
-            let r = find(&mut parent, f as u32) as usize;
+            let r = sets.find(f);
             if root_label[r] == NONE {
                 root_label[r] = n_comp;
                 n_comp += 1;
@@ -218,14 +200,13 @@ impl Topology {
         // A vertex is manifold when its faces form a single fan: connected through edges at
         // the vertex that are manifold (exactly two faces, opposite directions).
         let mut out = Vec::new();
-        let mut parent: Vec<u32> = Vec::new();
+        let mut sets = UnionFind::default();
         for v in 0..self.n_vertices {
             let faces = self.vertex_faces(VertexId::new(v));
             if faces.len() <= 1 {
                 continue;
             }
-            parent.clear();
-            parent.extend(0..faces.len() as u32);
+            sets.reset(faces.len());
             for (a, &f) in faces.iter().enumerate() {
                 let t = self.triangles[f.idx()];
                 for i in 0..3 {
@@ -238,12 +219,12 @@ impl Topology {
                     }
                     let g = FaceId(o / 3);
                     if let Some(b) = faces.iter().position(|&x| x == g) {
-                        union(&mut parent, a as u32, b as u32);
+                        sets.union(a, b);
                     }
                 }
             }
-            let r0 = find(&mut parent, 0);
-            if (1..faces.len() as u32).any(|k| find(&mut parent, k) != r0) {
+            let r0 = sets.find(0);
+            if (1..faces.len()).any(|k| sets.find(k) != r0) {
                 out.push(VertexId::new(v));
             }
         }

@@ -445,21 +445,7 @@ impl<'a> Work<'a> {
 
     /// The metric quality `q = 2√3·a/(p·h)` of triangle `t` in its tensor `M_T`.
     fn quality(&self, t: [u32; 3]) -> f64 {
-        let p = t.map(|i| self.pts[i as usize]);
-        let m = self.tri_metric(t);
-        let len = |u: usize, v: usize| {
-            let e = p[v] - p[u];
-            e.dot(&(m * e)).max(0.0).sqrt()
-        };
-        let l = [len(1, 2), len(2, 0), len(0, 1)];
-        let area = 0.5 * (p[1] - p[0]).perp(&(p[2] - p[0])) * m.determinant().max(0.0).sqrt();
-        let semi = 0.5 * (l[0] + l[1] + l[2]);
-        let h = l[0].max(l[1]).max(l[2]);
-        if semi > 0.0 && h > 0.0 {
-            2.0 * 3f64.sqrt() * area / (semi * h)
-        } else {
-            0.0
-        }
+        super::stats::sides_and_quality(&t.map(|i| self.pts[i as usize]), &self.tri_metric(t)).1
     }
 
     fn energy(&self, t: [u32; 3]) -> f64 {

@@ -1,7 +1,7 @@
 //! Quality of a planar mesh in a metric (the yardstick of Sec. 4.1 applied in the plane).
 
 use super::{Metric2d, PlanarMesh};
-use nalgebra::Point2;
+use nalgebra::{Matrix2, Point2};
 use serde::Serialize;
 
 /// Quality summary of a planar mesh under a metric.
@@ -24,6 +24,25 @@ pub struct PlanarQuality {
     pub edges_in_range: f64,
 }
 
+/// The metric side lengths `[|p1p2|, |p2p0|, |p0p1|]` of a planar triangle in the tensor
+/// `m`, and its quality `q = 2√3·a/(p·h)` (Sec. 3.4; 0 for a degenerate triangle).
+pub(crate) fn sides_and_quality(p: &[Point2<f64>; 3], m: &Matrix2<f64>) -> ([f64; 3], f64) {
+    let len = |u: usize, v: usize| {
+        let e = p[v] - p[u];
+        e.dot(&(m * e)).max(0.0).sqrt()
+    };
+    let l = [len(1, 2), len(2, 0), len(0, 1)];
+    let area = 0.5 * (p[1] - p[0]).perp(&(p[2] - p[0])) * m.determinant().max(0.0).sqrt();
+    let semi = 0.5 * (l[0] + l[1] + l[2]);
+    let h = l[0].max(l[1]).max(l[2]);
+    let q = if semi > 0.0 && h > 0.0 {
+        2.0 * 3f64.sqrt() * area / (semi * h)
+    } else {
+        0.0
+    };
+    (l, q)
+}
+
 /// Measure `mesh` under `metric`: each triangle is mapped by the square root of the tensor at
 /// its centroid (its edge lengths become `√(eᵀ M_c e)`), then `q`, its angles; each edge's
 /// metric length uses the tensor at the edge midpoint.
@@ -37,19 +56,7 @@ pub fn planar_quality(
         let p = t.map(|i| mesh.points[i as usize]);
         let c = Point2::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
         let m = metric.metric(&c);
-        let len = |u: usize, v: usize| {
-            let e = p[v] - p[u];
-            e.dot(&(m * e)).max(0.0).sqrt()
-        };
-        let l = [len(1, 2), len(2, 0), len(0, 1)];
-        let area = 0.5 * (p[1] - p[0]).perp(&(p[2] - p[0])) * m.determinant().max(0.0).sqrt();
-        let semi = 0.5 * (l[0] + l[1] + l[2]);
-        let h = l[0].max(l[1]).max(l[2]);
-        let q = if semi > 0.0 && h > 0.0 {
-            2.0 * 3f64.sqrt() * area / (semi * h)
-        } else {
-            0.0
-        };
+        let (l, q) = sides_and_quality(&p, &m);
         // Smallest angle: opposite the shortest side, by the law of cosines.
         let th = (0..3)
             .map(|i| {
