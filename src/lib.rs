@@ -2,14 +2,20 @@
 #![doc = include_str!("../README.md")]
 //!
 //! # Module map (paper order)
-//! - [`mesh`], [`ids`], [`io`], [`predicates`], [`invariants`]: foundation.
-//! - [`metric`]: Sec. 3.1 / 4.1, the Riemannian metric field.
-//! - [`patches`]: Sec. 3.2, cone patches (Eq. 1-3).
-//! - [`param`]: Sec. 3.3, bijective parameterization.
-//! - [`remesh2d`]: Sec. 3.3, metric transfer (Eq. 4) and LCT remeshing.
-//! - [`lift`], [`stitch`]: Sec. 3.3 "Mapping back", patch replacement.
-//! - [`pipeline`]: Algorithm 1.
-//! - [`quality`], [`report`]: Sec. 4.1, the yardstick.
+//! - [`ids`], [`mesh`], [`io`], [`predicates`], [`invariants`], [`check`]: foundation (typed
+//!   ids, the triangle mesh and its topology, file formats, exact predicates, certificates).
+//! - [`metric`]: Sec. 3.1 / 4.1, the Riemannian metric field (curvature or user `.sol`).
+//! - [`features`]: feature lines kept as patch boundaries (ours).
+//! - [`patches`]: Sec. 3.2, cone patches (Eq. 1-3) and the [`patches::PatchStrategy`] registry.
+//! - [`param`]: Sec. 3.3, bijective parameterization and the [`param::Parameterizer`] registry.
+//! - [`remesh2d`]: Sec. 3.3, metric transfer (Eq. 4), LCT and the
+//!   [`remesh2d::PlanarRemesher`] registry.
+//! - [`lift`], [`stitch`]: Sec. 3.3 "Mapping back", replacing a patch.
+//! - [`fidelity`]: the distance control of a patch (ours).
+//! - [`pipeline`]: Algorithm 1, and [`pipeline::Remesher`], the whole job from file units.
+//! - [`improve`]: Sec. 3.4, connectivity and vertex position updates on the surface.
+//! - [`quality`], [`report`]: Sec. 4.1, the yardstick; JSON and plots.
+//! - [`registry`], [`contract`]: the extension points' tables and their contract checks.
 
 pub mod check;
 pub mod contract;

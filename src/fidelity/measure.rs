@@ -218,7 +218,7 @@ pub fn scale_metric(
     n
 }
 
-/// The a-priori factors of [`a_priori_scale`] carried onto the vertices of a patch of the
+/// The a-priori factors of [`super::a_priori_scale`] carried onto the vertices of a patch of the
 /// working mesh. The transferred metric is sampled only at the patch's vertices; once earlier
 /// patches have replaced the input there, no patch vertex may sit on a tip or rim whose
 /// factor is large, and the interpolated factor misses it. So every reference vertex with a

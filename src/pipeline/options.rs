@@ -47,10 +47,10 @@ pub struct RemeshOptions {
     /// it cuts thin tips).
     pub corner_pullback: bool,
     /// After the loop, the connectivity update on the surface
-    /// ([`crate::improve::flip_pass`]). Default `true`.
+    /// ([`crate::improve::connectivity_update`]). Default `true`.
     pub edge_flips: bool,
     /// After the flips, the vertex position update on the surface
-    /// ([`crate::improve::relocate_pass`]), then flips again. Default `true`.
+    /// ([`crate::improve::vertex_position_update`]), then flips again. Default `true`.
     pub relocate: bool,
     /// Input vertices whose angle defect `|2π − Σθ|` is at least this many radians are kept
     /// as vertices of the output (our addition, see [`crate::patches::corner_vertices`]): no

@@ -17,7 +17,8 @@ use super::options::{RemeshOptions, Stages};
 use super::records::{Progress, RemeshResult, Warning};
 use crate::invariants;
 use crate::mesh::{SurfaceLocation, TriMesh};
-use crate::metric::{MetricField, MetricOptions, Normalization};
+use crate::ids::VertexId;
+use crate::metric::{MetricError, MetricField, MetricOptions, Normalization};
 use nalgebra::Matrix3;
 
 /// Algorithm 1 from a mesh in file units: [`Remesher::run`] drops unreferenced vertices,
@@ -124,10 +125,10 @@ impl Remesher {
             kept
         });
         let field = match &input_metric {
-            Some(m) => MetricField::new(
-                reference,
-                m.iter().map(|m| norm.metric_to_unit(m)).collect(),
-            )?,
+            Some(m) => {
+                let unit = m.iter().map(|m| norm.metric_to_unit(m)).collect();
+                MetricField::new(reference, unit).map_err(|e| in_file_numbering(e, &map))?
+            }
             None => MetricField::from_curvature(reference, &self.metric)?,
         };
         let unit = super::remesh(&field, &self.stages, &self.options, on_progress)?;
@@ -154,6 +155,25 @@ impl Remesher {
             normalization: norm,
             field,
         })
+    }
+}
+
+/// A metric error names the vertex in the compacted input; name it as in the file.
+fn in_file_numbering(e: MetricError, map: &[Option<VertexId>]) -> MetricError {
+    let file_id = |v: usize| {
+        map.iter()
+            .position(|n| n.is_some_and(|n| n.idx() == v))
+            .unwrap_or(v)
+    };
+    match e {
+        MetricError::NotSpd { vertex, detail } => MetricError::NotSpd {
+            vertex: file_id(vertex),
+            detail,
+        },
+        MetricError::NonFinite { vertex } => MetricError::NonFinite {
+            vertex: file_id(vertex),
+        },
+        other => other,
     }
 }
 
