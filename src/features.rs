@@ -135,6 +135,7 @@ impl EdgeSplitter {
             let v = VertexId::new(work.mesh.positions.len());
             work.mesh.positions.push(loc.position(reference));
             work.locations.push(loc);
+            work.curve.push(None);
             chain.push(v);
         }
         chain.push(b);

@@ -17,6 +17,7 @@
 //! - [`quality`], [`report`]: Sec. 4.1, the yardstick; JSON and plots.
 //! - [`registry`], [`contract`]: the extension points' tables and their contract checks.
 
+pub mod boundary;
 pub mod check;
 pub mod contract;
 pub mod error;

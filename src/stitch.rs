@@ -8,6 +8,7 @@
 //! elements are stable while the loop runs.
 
 use crate::ids::{FaceId, VertexId};
+use crate::boundary::CurvePoint;
 use crate::mesh::{SurfaceLocation, TriMesh};
 use nalgebra::Point3;
 use thiserror::Error;
@@ -38,6 +39,9 @@ pub struct WorkingMesh {
     pub locations: Vec<SurfaceLocation>,
     /// `processed[f]`: face `f` was produced by (or lies inside) an already remeshed patch.
     pub processed: Vec<bool>,
+    /// `curve[v]`: where vertex `v` lies on the input's boundary curves, for boundary
+    /// vertices ([`crate::boundary`]); `None` inside.
+    pub curve: Vec<Option<CurvePoint>>,
 }
 
 /// A vertex of a replacement triangle: an existing working-mesh vertex (patch boundary) or
@@ -57,6 +61,9 @@ pub struct Replacement {
     pub new_positions: Vec<Point3<f64>>,
     /// Their locations on the reference surface (parallel to `new_positions`).
     pub new_locations: Vec<SurfaceLocation>,
+    /// Their points on the input's boundary curves (parallel to `new_positions`; missing
+    /// entries are `None`: a vertex inside the surface).
+    pub new_curve: Vec<Option<CurvePoint>>,
     /// The triangles, counter-clockwise seen from outside.
     pub triangles: Vec<[PatchVertex; 3]>,
 }
@@ -86,6 +93,7 @@ impl WorkingMesh {
             mesh: reference.clone(),
             locations,
             processed: vec![false; reference.n_faces()],
+            curve: vec![None; reference.n_vertices()],
         }
     }
 
@@ -104,13 +112,16 @@ impl WorkingMesh {
             };
             mesh.n_vertices()
         ];
+        let mut curve = vec![None; mesh.n_vertices()];
         for (old, new) in map.iter().enumerate() {
             if let Some(n) = new {
                 locations[n.idx()] = self.locations[old];
+                curve[n.idx()] = self.curve.get(old).copied().flatten();
             }
         }
         self.mesh = mesh;
         self.locations = locations;
+        self.curve = curve;
         map
     }
 }
@@ -166,6 +177,12 @@ pub fn stitch(
         .positions
         .extend_from_slice(&replacement.new_positions);
     work.locations.extend_from_slice(&replacement.new_locations);
+    let n = work.mesh.n_vertices();
+    work.curve.resize(n - replacement.new_positions.len(), None);
+    for i in 0..replacement.new_positions.len() {
+        work.curve
+            .push(replacement.new_curve.get(i).copied().flatten());
+    }
     work.processed = processed;
     Ok((first_new..work.mesh.n_faces()).map(FaceId::new).collect())
 }
@@ -186,6 +203,7 @@ mod tests {
         let repl = Replacement {
             new_positions: vec![Point3::new(0.01, 0.0, 0.0)],
             new_locations: vec![w.locations[0]],
+            new_curve: Vec::new(),
             triangles: (0..6)
                 .map(|i| {
                     [

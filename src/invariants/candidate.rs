@@ -285,12 +285,11 @@ mod tests {
                 let new_tris: Vec<[VertexId; 3]> =
                     fan.iter().map(|f| work.mesh.triangles[f.idx()]).collect();
                 let r = Replacement {
-                    new_positions: Vec::new(),
-                    new_locations: Vec::new(),
                     triangles: new_tris
                         .iter()
                         .map(|t| t.map(PatchVertex::Existing))
                         .collect(),
+                    ..Replacement::default()
                 };
                 let full = certify_candidate_embedded(&work, &fan, &r).is_ok();
                 let local = candidate_embedded_local(&work.mesh, &grid, &fan, &new_tris);

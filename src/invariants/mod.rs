@@ -94,6 +94,19 @@ pub enum InvariantError {
     /// Input boundary edges that vanished.
     #[error("boundary edges not preserved: {0}")]
     BoundaryEdgesMissing(Offenders<EdgeKey>),
+    /// Boundary vertices that are not on the input's boundary curves (no curve point, or
+    /// not exactly at it).
+    #[error("boundary vertices not on the input's boundary curves: {0}")]
+    BoundaryOffCurve(Offenders<VertexId>),
+    /// Boundary loops that do not go once around the input's curves.
+    #[error("boundary curves not followed: {reason}")]
+    BoundaryCurves {
+        /// which loop, naming a vertex
+        reason: String,
+    },
+    /// Corners of the input's boundary curves that are not output vertices.
+    #[error("boundary corners lost (input vertices): {0}")]
+    BoundaryCornersLost(Offenders<VertexId>),
     /// A patch that is not a topological disk.
     #[error("patch is not a disk: {reason}")]
     NotADisk {
@@ -130,3 +143,6 @@ pub use flips::FlipTest;
 
 mod candidate;
 pub use candidate::*;
+
+mod curves;
+pub use curves::certify_boundary_on_curves;

@@ -68,6 +68,15 @@ pub fn triangulate_polygon(
     boundary: &[Point2<f64>],
     interior: &[Point2<f64>],
 ) -> Result<PlanarDomain, Remesh2dError> {
+    triangulate_polygon_with(boundary, interior).map(|(d, _)| d)
+}
+
+/// [`triangulate_polygon`], also returning which `interior` points were kept (their indices
+/// into `interior`, in order: the domain's points after the boundary).
+pub fn triangulate_polygon_with(
+    boundary: &[Point2<f64>],
+    interior: &[Point2<f64>],
+) -> Result<(PlanarDomain, Vec<usize>), Remesh2dError> {
     let nb = boundary.len();
     if nb < 3 {
         return Err(Remesh2dError::InvalidDomain(format!(
@@ -83,11 +92,10 @@ pub fn triangulate_polygon(
         ));
     }
     let mut points: Vec<Point2<f64>> = boundary.to_vec();
-    points.extend(
-        interior
-            .iter()
-            .filter(|p| point_in_polygon(boundary, p) == Some(true)),
-    );
+    let kept: Vec<usize> = (0..interior.len())
+        .filter(|&i| point_in_polygon(boundary, &interior[i]) == Some(true))
+        .collect();
+    points.extend(kept.iter().map(|&i| interior[i]));
     let verts: Vec<spade::Point2<f64>> = points
         .iter()
         .map(|p| spade::Point2::new(p.x, p.y))
@@ -164,5 +172,5 @@ pub fn triangulate_polygon(
     };
     crate::invariants::certify_planar(&dom, &identity)
         .map_err(|e| Remesh2dError::InvalidDomain(format!("triangulation: {e}")))?;
-    Ok(dom)
+    Ok((dom, kept))
 }

@@ -210,6 +210,15 @@ impl PlanarMetricField {
         best.map(|f| (f as usize, self.barycentric(f as usize, p)))
     }
 
+    /// [`PlanarMetricField::locate`], or outside the mesh the nearest triangle and the
+    /// clamped barycentric coordinates of `p` in it (the nearest point of the mesh).
+    pub fn locate_or_nearest(&self, p: &Point2<f64>) -> (usize, [f64; 3]) {
+        self.locate(p).unwrap_or_else(|| {
+            let f = self.nearest_triangle(p);
+            (f, self.barycentric(f, p))
+        })
+    }
+
     /// `true` when `p` lies in the closed triangle `f` (exact).
     fn contains(&self, f: usize, p: &Point2<f64>) -> bool {
         let [a, b, c] = self.triangles[f].map(|i| self.points[i as usize]);

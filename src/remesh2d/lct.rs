@@ -42,6 +42,9 @@ pub struct LctOptions {
     pub split_ratio: f64,
     /// Collapse interior edges whose metric length is below `collapse_ratio · L` (default 4/5).
     pub collapse_ratio: f64,
+    /// A collapse is refused when an edge it makes is longer than this times L (default
+    /// `None`: `split_ratio`).
+    pub collapse_guard: Option<f64>,
     /// Smoothing passes per round, each followed by flips (default 3).
     pub smoothing_iters: usize,
     /// Maximum split passes and collapse passes per round (default 6 each).
@@ -63,6 +66,13 @@ pub struct LctOptions {
     pub valence_quality_guard: f64,
     /// Run [`certify_planar`] after every round, not only at the end (default true).
     pub certify_every_round: bool,
+    /// Start from the constrained Delaunay triangulation of the boundary polygon and of the
+    /// domain's interior vertices that are `start_spacing · L` apart in the metric, instead of
+    /// the domain's triangulation (default true), so the result does not inherit the input's
+    /// connectivity.
+    pub rebuild: bool,
+    /// The spacing of the interior vertices kept for the start, times L (default 0.8).
+    pub start_spacing: f64,
 }
 
 impl Default for LctOptions {
@@ -71,6 +81,7 @@ impl Default for LctOptions {
             rounds: 8,
             split_ratio: 4.0 / 3.0,
             collapse_ratio: 4.0 / 5.0,
+            collapse_guard: None,
             smoothing_iters: 3,
             max_passes: 6,
             newton_steps: 2,
@@ -80,6 +91,8 @@ impl Default for LctOptions {
             final_maxmin_flips: true,
             tensor_at_centroid: false,
             certify_every_round: true,
+            rebuild: true,
+            start_spacing: 0.8,
         }
     }
 }
@@ -105,6 +118,89 @@ impl PlanarRemesher for Lct {
     ) -> Result<PlanarMesh, Remesh2dError> {
         remesh_planar(domain, metric, target_length, &self.options, rng)
     }
+}
+
+/// The start of the rounds: the constrained Delaunay triangulation of the domain's boundary
+/// polygon and of those of its interior vertices that are at least `spacing` apart in the
+/// metric from the boundary and from each other (taken in id order), as a remesh of `domain`;
+/// `None` when spade cannot triangulate it. The result does not inherit the input's
+/// connectivity (a regular input grid that is anisotropic in the metric is a fixed point of
+/// split, collapse, flip and smoothing), while a fine input gives a well-spaced start.
+fn from_boundary(domain: &PlanarDomain, metric: &dyn Metric2d, spacing: f64) -> Option<PlanarMesh> {
+    let loop_points: Vec<Point2<f64>> = domain
+        .boundary
+        .iter()
+        .map(|&b| domain.points[b as usize])
+        .collect();
+    let mut on_boundary = vec![false; domain.points.len()];
+    for &b in &domain.boundary {
+        on_boundary[b as usize] = true;
+    }
+    let interior: Vec<u32> = (0..domain.points.len() as u32)
+        .filter(|&i| !on_boundary[i as usize])
+        .collect();
+    let kept = spaced(domain, metric, &interior, spacing);
+    let points: Vec<Point2<f64>> = kept.iter().map(|&i| domain.points[i as usize]).collect();
+    let (cdt, inside) = super::triangulate_polygon_with(&loop_points, &points).ok()?;
+    let mut origin: Vec<Option<u32>> = domain.boundary.iter().map(|&b| Some(b)).collect();
+    origin.extend(inside.iter().map(|&i| Some(kept[i])));
+    (origin.len() == cdt.points.len()).then(|| PlanarMesh {
+        points: cdt.points,
+        triangles: cdt.triangles,
+        origin,
+    })
+}
+
+/// The candidates (ids of `domain`'s points) at least `spacing` from the boundary vertices and
+/// from each other in the metric (mean of the two points' tensors), greedily in order.
+fn spaced(domain: &PlanarDomain, metric: &dyn Metric2d, candidates: &[u32], spacing: f64) -> Vec<u32> {
+    if candidates.is_empty() || !(spacing > 0.0) {
+        return Vec::new();
+    }
+    let tensor = |i: u32| clamp_spd(&metric.metric(&domain.points[i as usize]));
+    // Cells as large as the largest metric ball of radius `spacing`, so that every point
+    // closer than `spacing` lies in the 3×3 cells around a candidate.
+    let mut cell = 0.0f64;
+    let mut tensors: HashMap<u32, Matrix2<f64>> = HashMap::new();
+    for &i in domain.boundary.iter().chain(candidates) {
+        if let Some(m) = tensor(i) {
+            let lmin = m.symmetric_eigenvalues().min();
+            if lmin > 0.0 {
+                cell = cell.max(spacing / lmin.sqrt());
+            }
+            tensors.insert(i, m);
+        }
+    }
+    if !(cell.is_finite() && cell > 0.0) {
+        return Vec::new();
+    }
+    let key = |p: &Point2<f64>| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
+    let mut grid: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
+    for &b in &domain.boundary {
+        grid.entry(key(&domain.points[b as usize])).or_default().push(b);
+    }
+    let mut kept = Vec::new();
+    for &i in candidates {
+        let Some(mi) = tensors.get(&i) else { continue };
+        let p = domain.points[i as usize];
+        let (cx, cy) = key(&p);
+        let far = (cx - 1..=cx + 1).all(|x| {
+            (cy - 1..=cy + 1).all(|y| {
+                grid.get(&(x, y)).is_none_or(|js| {
+                    js.iter().all(|&j| {
+                        let m = tensors.get(&j).map_or(*mi, |mj| (mi + mj) * 0.5);
+                        let e = domain.points[j as usize] - p;
+                        e.dot(&(m * e)) >= spacing * spacing
+                    })
+                })
+            })
+        });
+        if far {
+            grid.entry((cx, cy)).or_default().push(i);
+            kept.push(i);
+        }
+    }
+    kept
 }
 
 /// The identity remesh of `domain` (every vertex its own origin).
@@ -149,7 +245,11 @@ pub fn remesh_planar(
         fixed[b as usize] = true;
         locked.insert((a.min(b), a.max(b)));
     }
-    let mut mesh = identity(domain);
+    let mut mesh = match options.rebuild && domain.constrained_edges.is_empty() {
+        true => from_boundary(domain, metric, target_length * options.start_spacing)
+            .unwrap_or_else(|| identity(domain)),
+        false => identity(domain),
+    };
     // Fixed/locked status travels with `origin` (input ids) across rounds.
     for round in 0..=options.rounds {
         let mut w = Work::new(&mesh, metric, target_length, &fixed, &locked, options)?;
@@ -242,6 +342,7 @@ struct Work<'a> {
     l: f64,
     split: f64,
     collapse: f64,
+    guard: f64,
     at_centroid: bool,
 }
 
@@ -291,6 +392,7 @@ impl<'a> Work<'a> {
             l,
             split: options.split_ratio,
             collapse: options.collapse_ratio,
+            guard: options.collapse_guard.unwrap_or(options.split_ratio),
             at_centroid: options.tensor_at_centroid,
         };
         w.he.reserve(mesh.triangles.len() * 6);
@@ -582,7 +684,7 @@ impl<'a> Work<'a> {
         if common != cd {
             return false;
         }
-        let limit = self.split * self.l;
+        let limit = self.guard * self.l;
         let mut new_tris = Vec::with_capacity(star_a.len());
         for &t in &star_a {
             if t == t1 || t == t2 {

@@ -10,7 +10,7 @@ mod stats;
 mod transfer;
 
 pub use demo::{demo_cases, run_demo_case, DemoDomain, DemoMetric};
-pub use domain::{metric_length, resample_polygon, triangulate_polygon};
+pub use domain::{metric_length, resample_polygon, triangulate_polygon, triangulate_polygon_with};
 pub use field::PlanarMetricField;
 pub use lct::{remesh_planar, Lct, LctOptions};
 pub use registry::{planar_remesher, REMESHERS};

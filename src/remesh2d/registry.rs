@@ -22,6 +22,18 @@ pub static REMESHERS: &[Entry<dyn PlanarRemesher>] = &[Entry {
             doc: "collapse interior edges shorter than this times L_tar [4/5]",
         },
         OptionDoc {
+            name: "collapse_guard",
+            doc: "refuse a collapse that makes an edge longer than this times L_tar [split_ratio]",
+        },
+        OptionDoc {
+            name: "rebuild",
+            doc: "start from the triangulated boundary polygon, not the domain's mesh [true]",
+        },
+        OptionDoc {
+            name: "start_spacing",
+            doc: "with rebuild, keep the domain's interior vertices this far apart (times L_tar) [0.8]",
+        },
+        OptionDoc {
             name: "smoothing_iters",
             doc: "smoothing passes per round, each followed by flips [3]",
         },
@@ -56,6 +68,15 @@ fn lct(p: &mut Params) -> Result<Box<dyn PlanarRemesher>, BadValue> {
         ratio(x) && x < 1.0
     })? {
         o.collapse_ratio = r;
+    }
+    if let Some(g) = p.take_checked("collapse_guard", "a number above 1", |x: f64| ratio(x) && x > 1.0)? {
+        o.collapse_guard = Some(g);
+    }
+    if let Some(b) = p.take("rebuild", "true or false")? {
+        o.rebuild = b;
+    }
+    if let Some(x) = p.take_checked("start_spacing", "a number ≥ 0", |x: f64| x.is_finite() && x >= 0.0)? {
+        o.start_spacing = x;
     }
     if let Some(n) = p.take("smoothing_iters", "a number of passes")? {
         o.smoothing_iters = n;
