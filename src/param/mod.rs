@@ -4,7 +4,6 @@
 mod distortion;
 mod lscm;
 mod sdirichlet;
-mod shaped;
 mod tutte;
 
 pub use distortion::{distortion, triangle_frames, TriangleFrame};
@@ -13,7 +12,6 @@ pub use sdirichlet::{
     initial_map, optimize_locally_injective, optimize_with_log, InitialMap, SdLog, SdOptions,
     SdProfile, SymmetricDirichlet,
 };
-pub use shaped::ellipse_boundary;
 pub use tutte::{circle_boundary, scale_to_area, tutte_embedding, Tutte, TutteWeights};
 
 use crate::ids::VertexId;

@@ -17,8 +17,7 @@
 //! * Start: the free-boundary LSCM when certified; else the LSCM after the overlap repair
 //!   (`repair_iters`) when that is certified; else the Tutte map. The repair steps are part
 //!   of computing the start: only the certified start and the iterates after it count.
-//! * Stopping: a step whose decrease is below `rel_tol` of the excess `E − 4`, or a Newton
-//!   direction whose predicted decrease (the decrement) is below `decrement_tol` of it.
+//! * Stopping: a step whose decrease is below `rel_tol` of the excess `E − 4`.
 //! * Line search: the largest flip-free step (smallest positive root of `det J(t) = 0` over
 //!   all triangles) times `step_fraction`, then Armijo backtracking; a trial is accepted only
 //!   if `certify_bijective` (exact) passes, so every iterate is certified.
@@ -78,9 +77,6 @@ pub struct SdOptions {
     /// boundary vertex meets a non-incident boundary edge (swept vertex–edge test), so the
     /// certificate rarely rejects a trial for a self-touching boundary [true].
     pub collision_bound: bool,
-    /// When the LSCM is not certified, start from the Tutte map onto the ellipse of the
-    /// LSCM boundary before falling back to the circle [true].
-    pub shaped_tutte_init: bool,
     /// Overlap repair of an LSCM that is not certified (its boundary overlaps itself, mostly
     /// where narrow slits of a ragged cover patch close): up to this many locally injective
     /// Newton steps from it on the symmetric Dirichlet energy plus a penalty pushing every
@@ -94,43 +90,9 @@ pub struct SdOptions {
     pub repair_weight: f64,
     /// Clearance the overlap repair aims for, as a fraction of the mean 3D edge length [0.2].
     pub repair_margin: f64,
-    /// Active set of the collision bound: when the bound cuts the step below this fraction
-    /// of the wanted step, re-solve with the colliding vertices stiffened along the edge
-    /// normal [0: measured slower, see paper-notes]; 0 disables.
-    pub collision_active_below: f64,
-    /// Re-solves per iteration for the active set \[2\].
-    pub collision_rounds: usize,
-    /// Stiffness of an active pair relative to the mean Hessian diagonal \[1e3\].
-    pub collision_stiffness: f64,
-    /// Also stop, before the line search, when the Newton decrement `−∇E·d` of the current
-    /// direction `d` (twice the decrease the quadratic model predicts for the full step) is
-    /// below this fraction of the energy excess `E − 4` [0 = off; 3e-3 measured]. Unlike
-    /// `rel_tol`, which judges the decrease a step achieved, this judges what is left, so
-    /// a step shortened by the collision bound (small achieved decrease, large decrement)
-    /// does not stop the iteration, while the tail of tiny full steps near the optimum is
-    /// skipped: over all cover patches of the shared meshes 28% fewer iterations with the
-    /// same area-weighted mean and worst max σ1/σ2 per mesh (paper-notes, Sec. 3.3). Off by
-    /// default: the total parameterization time fell only 2 %, and the slightly different
-    /// maps moved the remeshed outputs (screwdriver's Hausdorff 0.77 → 1.04 % of the diagonal).
-    pub decrement_tol: f64,
-    /// Adaptive boundary barrier (IPC-style, Li et al. 2020), weight of one term relative
-    /// to one average triangle's energy share [0 = off]. When the collision bound cuts a
-    /// step, every boundary (vertex, edge) pair it found enters the objective with the
-    /// smooth (C²) log barrier `−(x − 1)² ln x`, `x = d / d̂` on the triangle-inequality gap
-    /// `d`, activated at the pair's current gap (`d̂ = d`, so the objective does not jump);
-    /// the next Newton model then sees the pair instead of driving it shut again.
-    pub adaptive_barrier: f64,
     /// The overlap repair stops once the map is certified with every repaired vertex at
     /// least this fraction of `repair_margin` outside the edge it crossed \[0.5\].
     pub repair_clearance: f64,
-    /// With `adaptive_barrier > 0` and a repaired LSCM start, the certified optimisation
-    /// starts with the repaired pairs in the adaptive barrier, activated at this multiple of
-    /// their gap in the start (its barrier energy is part of the start's objective) \[0 = off\].
-    pub adaptive_seed: f64,
-    /// After every accepted step each adaptive pair's activation gap shrinks to at most
-    /// this multiple of its current gap, `d̂ ← min(d̂, γ d)` \[2\] (never grows, so the
-    /// objective never increases); pairs with `d̂` below the fixed barrier's `ε` are dropped.
-    pub adaptive_shrink: f64,
 }
 
 impl Default for SdOptions {
@@ -146,18 +108,10 @@ impl Default for SdOptions {
             barrier_weight: 1.0,
             abs_twist: true,
             collision_bound: true,
-            shaped_tutte_init: false,
             repair_iters: 30,
             repair_weight: 100.0,
             repair_margin: 0.2,
-            collision_active_below: 0.0,
-            collision_rounds: 2,
-            collision_stiffness: 1e3,
-            decrement_tol: 0.0,
-            adaptive_barrier: 0.0,
             repair_clearance: 0.5,
-            adaptive_seed: 0.0,
-            adaptive_shrink: 2.0,
         }
     }
 }
@@ -202,9 +156,6 @@ pub struct SdLog {
     pub factorizations: usize,
     /// Iterations whose first trial step was capped by the boundary-collision bound.
     pub collision_limited: usize,
-    /// Overlap repair: the (vertex, edge start, edge end) pairs it pushed apart (vertex
-    /// indices); empty for the certified optimisation.
-    pub repair_pairs: Vec<[usize; 3]>,
 }
 
 /// The fixed sparsity pattern of the 2n×2n Hessian (dof `2v + c`, full symmetric storage)
@@ -613,19 +564,10 @@ struct Problem<'a> {
     pen_w: f64,
     pen_margin: f64,
     pen_pairs: Vec<[usize; 3]>,
-    /// Adaptive barrier (`SdOptions::adaptive_barrier`): weight of one term, and the
-    /// (vertex, edge start, edge end) pairs with their activation gap `d̂`.
-    adapt_w: f64,
-    adaptive: Vec<([usize; 3], f64)>,
 }
 
-/// Triangle-inequality gap `|p − a| + |p − b| − |a − b|` of vertex `p` and edge `ab`
-/// (vertex indices), zero exactly when `p` lies on the segment.
-fn tri_gap(uv: &[Point2<f64>], p: usize, a: usize, b: usize) -> f64 {
-    (uv[p] - uv[a]).norm() + (uv[p] - uv[b]).norm() - (uv[a] - uv[b]).norm()
-}
-
-/// Gradient of [`tri_gap`] with respect to `p`, `a` and `b`.
+/// Gradient of the triangle-inequality gap `|p − a| + |p − b| − |a − b|` with respect to
+/// `p`, `a` and `b`.
 fn tri_gap_grad(uv: &[Point2<f64>], p: usize, a: usize, b: usize) -> [(usize, Vector2<f64>); 3] {
     let unit = |x: Point2<f64>, y: Point2<f64>| {
         let v = x - y;
@@ -642,22 +584,6 @@ fn tri_gap_grad(uv: &[Point2<f64>], p: usize, a: usize, b: usize) -> [(usize, Ve
         (a, unit(pa, pp) - unit(pa, pb)),
         (b, unit(pb, pp) - unit(pb, pa)),
     ]
-}
-
-/// The C² log barrier of IPC (Li et al. 2020) in the normalised gap `x = d / d̂`:
-/// `b(x) = −(x − 1)² ln x` on `(0, 1)`, 0 from 1 on; value, first and second derivative.
-/// `b`, `b'` and `b''` vanish at `x = 1`, so activating a pair at its current gap changes
-/// neither the objective nor its gradient.
-fn ipc_barrier(x: f64) -> (f64, f64, f64) {
-    if x >= 1.0 {
-        return (0.0, 0.0, 0.0);
-    }
-    let (l, y) = (x.ln(), x - 1.0);
-    (
-        -y * y * l,
-        -2.0 * y * l - y * y / x,
-        -2.0 * l - 4.0 * y / x + y * y / (x * x),
-    )
 }
 
 impl Problem<'_> {
@@ -681,13 +607,6 @@ impl Problem<'_> {
                 return f64::INFINITY;
             }
             e += self.barrier_w * (self.eps / d - 1.0).powi(2);
-        }
-        for &([p, a, b], dhat) in &self.adaptive {
-            let d = tri_gap(uv, p, a, b);
-            if d.is_nan() || d <= 0.0 {
-                return f64::INFINITY;
-            }
-            e += self.adapt_w * ipc_barrier(d / dhat).0;
         }
         for &[p, a, b] in &self.pen_pairs {
             if let Some((sd, _)) = signed_gap(uv, p, a, b) {
@@ -767,30 +686,6 @@ impl Problem<'_> {
                 vals[s[3] as usize] += d2 * gv.y * gv.y;
             }
         }
-        // Adaptive barrier: Gauss–Newton term b''(x)/d̂² ∇d ∇dᵀ on the 2×2 diagonal blocks
-        // (PSD since b'' ≥ 0 on (0, 1]), like the fixed barrier, so the pattern is unchanged.
-        for &([p, a, b], dhat) in &self.adaptive {
-            let d = tri_gap(uv, p, a, b);
-            if d.is_nan() || d <= 0.0 {
-                return Err(ParamError::NotCertified(format!(
-                    "boundary vertex v{p} touches boundary edge (v{a}, v{b})"
-                )));
-            }
-            let (_, b1, b2) = ipc_barrier(d / dhat);
-            if b2 == 0.0 && b1 == 0.0 {
-                continue;
-            }
-            let (d1, d2) = (self.adapt_w * b1 / dhat, self.adapt_w * b2 / (dhat * dhat));
-            for (v, gv) in tri_gap_grad(uv, p, a, b) {
-                grad[2 * v] += d1 * gv.x;
-                grad[2 * v + 1] += d1 * gv.y;
-                let s = &pat.diag_slots[v];
-                vals[s[0] as usize] += d2 * gv.x * gv.x;
-                vals[s[1] as usize] += d2 * gv.y * gv.x;
-                vals[s[2] as usize] += d2 * gv.x * gv.y;
-                vals[s[3] as usize] += d2 * gv.y * gv.y;
-            }
-        }
         // Overlap repair: w ((s + margin) / margin)² while positive, s the signed distance of
         // p inside the line of ab; gradient along the edge's inner normal (p moves out, a and b
         // by their share), Gauss–Newton diagonal blocks.
@@ -845,24 +740,11 @@ impl Problem<'_> {
 /// root counts when `p` then lies on the segment (with a small margin: over-counting only
 /// shortens the step). Broad phase: sort-and-sweep on x over the boxes swept in
 /// `[0, horizon]`, like the certificate's. The exact certificate stays the final judge.
-#[cfg(test)]
 fn max_collision_free_step(
     uv: &[Point2<f64>],
     dir: &[f64],
     boundary: &[VertexId],
     horizon: f64,
-) -> f64 {
-    collisions(uv, dir, boundary, horizon, &mut Vec::new())
-}
-
-/// [`max_collision_free_step`], also listing in `hits` every (vertex, edge start, edge end)
-/// triple (vertex indices) that meets within `horizon`.
-fn collisions(
-    uv: &[Point2<f64>],
-    dir: &[f64],
-    boundary: &[VertexId],
-    horizon: f64,
-    hits: &mut Vec<[usize; 3]>,
 ) -> f64 {
     let m = boundary.len();
     if m < 4 || horizon.is_nan() || horizon <= 0.0 {
@@ -893,7 +775,7 @@ fn collisions(
     items.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
     let mut tmax = horizon;
     let mut active: Vec<usize> = Vec::new();
-    let mut test = |vi: usize, ei: usize, tmax: &mut f64| {
+    let test = |vi: usize, ei: usize, tmax: &mut f64| {
         if vi == ei || vi == (ei + 1) % m {
             return;
         }
@@ -905,7 +787,6 @@ fn collisions(
         let c0 = e.perp(&w);
         let c1 = e.perp(&dw) + de.perp(&w);
         let c2 = de.perp(&dw);
-        let mut hit = false;
         for s in quadratic_roots(c2, c1, c0) {
             if s > 0.0 && s < horizon {
                 let (es, ws) = (e + de * s, w + dw * s);
@@ -913,13 +794,8 @@ fn collisions(
                 let u = if l2 > 0.0 { es.dot(&ws) / l2 } else { 0.5 };
                 if (-1e-6..=1.0 + 1e-6).contains(&u) {
                     *tmax = tmax.min(s);
-                    hit = true;
                 }
             }
-        }
-        if hit {
-            let b = |i: usize| boundary[i % m].idx();
-            hits.push([b(vi), b(ei), b(ei + 1)]);
         }
     };
     for k in 0..items.len() {
@@ -1098,7 +974,7 @@ pub fn optimize_with_log(
     options: &SdOptions,
 ) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
     certify(disk, uv0, boundary)?;
-    newton(disk, boundary, uv0, options, true, &OnceCell::new(), &[])
+    newton(disk, boundary, uv0, options, true, &OnceCell::new())
 }
 
 /// [`optimize_with_log`] without the global part: locally injective projected Newton (no
@@ -1112,7 +988,7 @@ pub fn optimize_locally_injective(
     uv0: &[Point2<f64>],
     options: &SdOptions,
 ) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
-    newton(disk, boundary, uv0, options, false, &OnceCell::new(), &[])
+    newton(disk, boundary, uv0, options, false, &OnceCell::new())
 }
 
 /// Projected Newton on the symmetric Dirichlet energy. `certified`: the full method of the
@@ -1127,7 +1003,6 @@ fn newton(
     options: &SdOptions,
     certified: bool,
     setup: &OnceCell<Setup>,
-    seed: &[[usize; 3]],
 ) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
     let n = disk.n_vertices();
     let frames = triangle_frames(disk);
@@ -1158,21 +1033,7 @@ fn newton(
         },
         pen_margin: options.repair_margin * disk.mean_edge_length(),
         pen_pairs: Vec::new(),
-        adapt_w: if certified {
-            options.adaptive_barrier / disk.n_faces() as f64
-        } else {
-            0.0
-        },
-        adaptive: Vec::new(),
     };
-    if prob.adapt_w > 0.0 {
-        for &[p, a, b] in seed {
-            let d = tri_gap(&uv, p, a, b);
-            if d > prob.eps {
-                prob.adaptive.push(([p, a, b], options.adaptive_seed * d));
-            }
-        }
-    }
     let clock = std::time::Instant::now();
     let mut lap = {
         let mut last = clock;
@@ -1223,31 +1084,13 @@ fn newton(
             .map(|v| vals[pat.diag_slots[v / 2][if v % 2 == 0 { 0 } else { 3 }] as usize])
             .sum();
         let mean_diag = trace / dim as f64;
-        // Newton direction for the Hessian plus `kappa · n nᵀ` on the 2×2 blocks of the
-        // vertices of every listed (vertex, edge) pair, `n` the edge normal.
-        let mut solve = |pairs: &[[usize; 3]], log: &mut SdLog| -> Result<Vec<f64>, ParamError> {
+        let mut solve = |log: &mut SdLog| -> Result<Vec<f64>, ParamError> {
             let mut mu = 1e-8 * mean_diag;
-            let kappa = options.collision_stiffness * mean_diag;
             for _ in 0..8 {
                 shifted.copy_from_slice(&vals);
                 for vv in 0..n {
                     shifted[pat.diag_slots[vv][0] as usize] += mu;
                     shifted[pat.diag_slots[vv][3] as usize] += mu;
-                }
-                for &[p, a, b] in pairs {
-                    let e = uv[b] - uv[a];
-                    let l = e.norm();
-                    if l <= 0.0 {
-                        continue;
-                    }
-                    let nn = Vector2::new(-e.y, e.x) / l;
-                    for v in [p, a, b] {
-                        let s = &pat.diag_slots[v];
-                        shifted[s[0] as usize] += kappa * nn.x * nn.x;
-                        shifted[s[1] as usize] += kappa * nn.y * nn.x;
-                        shifted[s[2] as usize] += kappa * nn.x * nn.y;
-                        shifted[s[3] as usize] += kappa * nn.y * nn.y;
-                    }
                 }
                 let mat = SparseColMatRef::new(sym, &shifted);
                 log.factorizations += 1;
@@ -1278,76 +1121,22 @@ fn newton(
                 "Newton Hessian is not positive definite".to_string(),
             ))
         };
-        let mut dir = solve(&[], &mut log)?;
-        let mut slope: f64 = dir.iter().zip(&grad).map(|(d, g)| d * g).sum();
+        let dir = solve(&mut log)?;
+        let slope: f64 = dir.iter().zip(&grad).map(|(d, g)| d * g).sum();
         log.time_ms[2] += lap();
         // NaN-safe: a NaN slope also means no usable descent direction.
         if slope.is_nan() || slope >= 0.0 {
             converged = true; // no descent direction left
             break;
         }
-        // What is left to gain: the quadratic model predicts −slope/2 for the full step.
-        // Trusted only when the twist is clamped (`abs_twist` off: the last step was full),
-        // since the absolute-value filter inflates the model's curvature and so shrinks the
-        // decrement. Not in the overlap repair, which stops on its own rule.
-        if certified && !abs_twist && -slope < options.decrement_tol * (energy - 4.0).max(0.0) {
-            converged = true;
-            break;
-        }
-        let mut t_flip = prob.max_flip_free_step(&uv, &dir);
+        let t_flip = prob.max_flip_free_step(&uv, &dir);
         // Boundary-collision bound over the steps the first trial can reach (the
         // extrapolation beyond it is judged by the certificate alone).
-        let mut horizon = t_flip.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
+        let horizon = t_flip.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
         let mut t_coll = horizon;
         // Not in the overlap repair: resolving an overlap moves vertices across edges.
         if options.collision_bound && certified {
-            let mut pairs = Vec::new();
-            t_coll = collisions(&uv, &dir, boundary, horizon, &mut pairs);
-            // Active set: the step is cut short by boundary vertices about to hit boundary
-            // edges; stiffen the Hessian against their motion along the edge normal (a PSD
-            // term, so the new direction is still a descent direction) and re-solve, so that
-            // one colliding pair no longer shortens the step of the whole map.
-            let mut rounds = 0;
-            while t_coll < options.collision_active_below * horizon
-                && rounds < options.collision_rounds
-            {
-                rounds += 1;
-                let d2 = solve(&pairs, &mut log)?;
-                let s2: f64 = d2.iter().zip(&grad).map(|(d, g)| d * g).sum();
-                if s2.is_nan() || s2 >= 0.0 {
-                    break;
-                }
-                let f2 = prob.max_flip_free_step(&uv, &d2);
-                let h2 = f2.min(1.0 / options.step_fraction.max(f64::MIN_POSITIVE));
-                let mut more = Vec::new();
-                let c2 = collisions(&uv, &d2, boundary, h2, &mut more);
-                // Keep the new direction only if it predicts more decrease within its bound.
-                let gain = |s: f64, t: f64| -s * t.min(1.0);
-                if gain(s2, c2) <= gain(slope, t_coll) {
-                    break;
-                }
-                dir = d2;
-                slope = s2;
-                t_flip = f2;
-                horizon = h2;
-                t_coll = c2;
-                for p in more {
-                    if !pairs.contains(&p) {
-                        pairs.push(p);
-                    }
-                }
-            }
-            // Adaptive barrier: every pair the bound found enters the objective activated at
-            // its current gap (value, gradient and Hessian 0 there: the objective and this
-            // iteration's direction are unchanged, the line search already sees the term).
-            if prob.adapt_w > 0.0 && t_coll < horizon {
-                for &[p, a, b] in &pairs {
-                    let d = tri_gap(&uv, p, a, b);
-                    if d > prob.eps && !prob.adaptive.iter().any(|(q, _)| *q == [p, a, b]) {
-                        prob.adaptive.push(([p, a, b], d));
-                    }
-                }
-            }
+            t_coll = max_collision_free_step(&uv, &dir, boundary, horizon);
             log.time_ms[2] += lap();
         }
         let t_safe = options.step_fraction * t_flip;
@@ -1422,23 +1211,6 @@ fn newton(
         // relative to E itself the constant 4 would stop developable patches early.
         let rel = (energy - e_new) / (energy - 4.0).max(f64::MIN_POSITIVE);
         energy = e_new;
-        if !prob.adaptive.is_empty() {
-            // Shrink the activation gaps towards the pairs' current gaps (the objective can
-            // only fall), so closing slits can approach contact over the iterations.
-            let (gamma, eps) = (options.adaptive_shrink, prob.eps);
-            let mut changed = false;
-            prob.adaptive.retain_mut(|([p, a, b], dhat)| {
-                let cap = gamma * tri_gap(&uv, *p, *a, *b);
-                if cap < *dhat {
-                    *dhat = cap;
-                    changed = true;
-                }
-                *dhat > eps
-            });
-            if changed {
-                energy = prob.energy(&uv).min(energy);
-            }
-        }
         if !certified && prob.pen_w > 0.0 {
             // Overlap repair: done once the map is certified with every repaired vertex at
             // least half the clearance outside; else add the newly penetrating vertices.
@@ -1473,7 +1245,6 @@ fn newton(
         }
     }
     log.hit_budget = !converged && !log.fell_back && log.iterations >= options.max_iters;
-    log.repair_pairs = prob.pen_pairs;
     Ok((uv, log))
 }
 
@@ -1485,17 +1256,13 @@ pub enum InitialMap {
     /// The overlapping LSCM after the overlap repair (`repair_iters`: locally injective
     /// symmetric Dirichlet steps with a penetration penalty) passed the certificate.
     RepairedLscm,
-    /// Tutte map onto the ellipse of the (overlapping) LSCM boundary.
-    EllipseTutte,
     /// Tutte map onto a circle (the certified fallback).
     CircleTutte,
 }
 
 /// The certified initial map of [`SymmetricDirichlet`], scaled to the 3D area: the LSCM if
 /// it passes the exact certificate; else (`repair_iters > 0`) the repaired LSCM if it
-/// passes; else (`shaped_tutte_init`) the Tutte map onto the
-/// ellipse of the LSCM boundary ([`super::ellipse_boundary`], strictly convex, so Tutte's
-/// theorem applies) if it passes; else the circle Tutte map (`init_weights`, then uniform).
+/// passes; else the circle Tutte map (`init_weights`, then uniform).
 pub fn initial_map(
     disk: &TriMesh,
     boundary: &[VertexId],
@@ -1536,7 +1303,7 @@ fn initial_map_with(
                     max_iters: options.repair_iters,
                     ..*options
                 };
-                let repaired = newton(disk, boundary, &uv, &o, false, setup, &[]);
+                let repaired = newton(disk, boundary, &uv, &o, false, setup);
                 let mut out = None;
                 if let Ok((mut r, log)) = repaired {
                     prof.repair = Some(log);
@@ -1548,18 +1315,6 @@ fn initial_map_with(
                 prof.repair_ms = ms(clock);
                 if let Some(r) = out {
                     return Ok((r, InitialMap::RepairedLscm));
-                }
-            }
-            if options.shaped_tutte_init {
-                if let Some(shape) = super::ellipse_boundary(disk, boundary, &uv) {
-                    if let Ok(mut t) =
-                        super::tutte_embedding(disk, boundary, &shape, options.init_weights)
-                    {
-                        scale_to_area(disk, &mut t);
-                        if certify(disk, &t, boundary).is_ok() {
-                            return Ok((t, InitialMap::EllipseTutte));
-                        }
-                    }
                 }
             }
         }
@@ -1621,15 +1376,7 @@ impl SymmetricDirichlet {
         // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
         // finite float energy, or a failed factorisation), the certified Tutte map is returned.
         // `initial_map_with` certified `uv0`.
-        // The slits the overlap repair opened tend to close again: seed the adaptive barrier
-        // with the repaired pairs (`adaptive_seed`).
-        let seed = match (&prof.repair, kind) {
-            (Some(r), InitialMap::RepairedLscm) if self.options.adaptive_seed > 0.0 => {
-                r.repair_pairs.clone()
-            }
-            _ => Vec::new(),
-        };
-        let (mut uv, log) = match newton(disk, boundary, &uv0, &self.options, true, &setup, &seed) {
+        let (mut uv, log) = match newton(disk, boundary, &uv0, &self.options, true, &setup) {
             Ok(r) => r,
             Err(_) => (
                 uv0,
@@ -1824,160 +1571,6 @@ mod tests {
             .map(|(p, q)| (p - q).norm())
             .fold(0.0, f64::max);
         assert!(err < 1e-9, "{err}");
-    }
-
-    /// The disk's boundary and its certified cotan Tutte map (the optimiser tests' start).
-    fn cotan_tutte_start(disk: &TriMesh) -> (Vec<VertexId>, Vec<Point2<f64>>) {
-        let boundary = super::super::disk_boundary(disk).unwrap();
-        let (uv0, _) = certified_tutte(disk, &boundary, TutteWeights::Cotan).unwrap();
-        (boundary, uv0)
-    }
-
-    /// The certified Newton optimisation from `uv0` (panics if it fails).
-    fn certified_newton(
-        disk: &TriMesh,
-        boundary: &[VertexId],
-        uv0: &[Point2<f64>],
-        o: &SdOptions,
-    ) -> (Vec<Point2<f64>>, SdLog) {
-        newton(disk, boundary, uv0, o, true, &OnceCell::new(), &[]).unwrap()
-    }
-
-    #[test]
-    fn decrement_stop_skips_only_the_tail() {
-        // A spherical cap (not developable: the optimum keeps an excess E − 4 > 0) from its
-        // circle Tutte map.
-        let mut disk = crate::mesh::generators::disk(1.0, 12, 6);
-        for p in &mut disk.positions {
-            p.z = (4.0 - p.x * p.x - p.y * p.y).sqrt();
-        }
-        let (boundary, uv0) = cotan_tutte_start(&disk);
-        let run = |decrement_tol: f64| {
-            certified_newton(
-                &disk,
-                &boundary,
-                &uv0,
-                &SdOptions {
-                    decrement_tol,
-                    ..Default::default()
-                },
-            )
-        };
-        let (uv_full, full) = run(0.0);
-        let (uv_tail, tail) = run(3e-3);
-        crate::invariants::certify_bijective(&uv_tail, &disk.triangles, &boundary).unwrap();
-        crate::invariants::certify_bijective(&uv_full, &disk.triangles, &boundary).unwrap();
-        // Same trajectory up to the stop, so never more iterations, and it stops early here.
-        assert!(
-            tail.iterations < full.iterations,
-            "{} {}",
-            tail.iterations,
-            full.iterations
-        );
-        assert_eq!(tail.energies[..], full.energies[..tail.energies.len()]);
-        // What it skips is below the predicted remainder (a few 1e-3 of the excess).
-        let (et, ef) = (
-            *tail.energies.last().unwrap(),
-            *full.energies.last().unwrap(),
-        );
-        assert!(!tail.hit_budget && !tail.fell_back);
-        assert!(et - ef <= 1e-2 * (et - 4.0), "{et} {ef}");
-    }
-
-    #[test]
-    fn ipc_barrier_is_c2_at_activation_and_convex() {
-        // Value, slope and curvature vanish at x = 1 (activating a pair at its current gap
-        // changes neither the objective nor the Newton model), and it is a barrier.
-        assert_eq!(ipc_barrier(1.0), (0.0, 0.0, 0.0));
-        assert_eq!(ipc_barrier(1.5), (0.0, 0.0, 0.0));
-        let (b, b1, b2) = ipc_barrier(1.0 - 1e-4);
-        assert!(
-            b < 1e-11 && b1.abs() < 1e-7 && b2.abs() < 1e-3,
-            "{b} {b1} {b2}"
-        );
-        assert!(ipc_barrier(1e-9).0 > 10.0);
-        let h = 1e-6;
-        for x in [0.05, 0.2, 0.5, 0.9, 0.999] {
-            let (_, d1, d2) = ipc_barrier(x);
-            let fd1 = (ipc_barrier(x + h).0 - ipc_barrier(x - h).0) / (2.0 * h);
-            let fd2 = (ipc_barrier(x + h).1 - ipc_barrier(x - h).1) / (2.0 * h);
-            assert!(
-                (fd1 - d1).abs() < 1e-6 * (1.0 + d1.abs()),
-                "{x}: {fd1} {d1}"
-            );
-            assert!(
-                (fd2 - d2).abs() < 1e-5 * (1.0 + d2.abs()),
-                "{x}: {fd2} {d2}"
-            );
-            // Decreasing and convex: the Gauss–Newton term b'' ∇d ∇dᵀ is PSD.
-            assert!(d1 < 0.0 && d2 > 0.0, "{x}: {d1} {d2}");
-        }
-    }
-
-    /// An annular sector over `angle > 2π` lifted as a helicoid (z = cθ): nearly flat, so
-    /// the isometric unfolding overlaps itself and the slit between its two straight sides
-    /// has to close to contact in the certified optimum.
-    fn helicoid_slit(angle: f64, nr: usize, nt: usize) -> TriMesh {
-        let mut pos = Vec::new();
-        for i in 0..=nr {
-            let r = 0.4 + 0.6 * i as f64 / nr as f64;
-            for j in 0..=nt {
-                let t = angle * j as f64 / nt as f64;
-                pos.push(nalgebra::Point3::new(r * t.cos(), r * t.sin(), 0.03 * t));
-            }
-        }
-        let v = |i: usize, j: usize| i * (nt + 1) + j;
-        let mut tris = Vec::new();
-        for i in 0..nr {
-            for j in 0..nt {
-                tris.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
-                tris.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
-            }
-        }
-        TriMesh::from_indices(pos, &tris).unwrap()
-    }
-
-    #[test]
-    fn adaptive_barrier_on_a_closing_slit() {
-        let disk = helicoid_slit(std::f64::consts::TAU + 0.4, 4, 48);
-        let (boundary, uv0) = cotan_tutte_start(&disk);
-        let run = |adaptive_barrier: f64| {
-            certified_newton(
-                &disk,
-                &boundary,
-                &uv0,
-                &SdOptions {
-                    adaptive_barrier,
-                    ..Default::default()
-                },
-            )
-        };
-        let (_, off) = run(0.0);
-        let (uv, on) = run(0.1);
-        // Measured: off 25 iterations, 17 of them cut by the collision bound; on 15, 1.
-        crate::invariants::certify_bijective(&uv, &disk.triangles, &boundary).unwrap();
-        assert!(on.min_double_area.iter().all(|&a| a > 0.0));
-        assert!(
-            on.energies.windows(2).all(|w| w[1] <= w[0]),
-            "{:?}",
-            on.energies
-        );
-        assert!(!on.hit_budget && !on.fell_back);
-        assert!(
-            off.collision_limited >= 10 && on.collision_limited <= 3,
-            "{} {}",
-            off.collision_limited,
-            on.collision_limited
-        );
-        assert!(
-            on.iterations < off.iterations,
-            "{} {}",
-            on.iterations,
-            off.iterations
-        );
-        // The barrier holds the slit a little open: a slightly higher excess E − 4.
-        let (e_on, e_off) = (on.energies.last().unwrap(), off.energies.last().unwrap());
-        assert!(e_on - 4.0 <= 1.5 * (e_off - 4.0), "{e_on} {e_off}");
     }
 
     #[test]
