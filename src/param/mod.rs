@@ -4,6 +4,7 @@
 mod distortion;
 mod lscm;
 mod sdirichlet;
+mod sparse;
 mod tutte;
 
 pub use distortion::{distortion, triangle_frames, TriangleFrame};

@@ -23,18 +23,15 @@
 //!   if `certify_bijective` (exact) passes, so every iterate is certified.
 
 use super::distortion::{jacobian, triangle_frames, TriangleFrame};
+use super::lscm::lscm_on;
+use super::sparse::{Llt, Pattern, VertexSystem};
 use super::tutte::{certified_tutte, scale_to_area, TutteWeights};
 use super::{
     certify, distortion, recertify, validate_disk, ParamError, Parameterization, Parameterizer,
 };
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
-use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams};
-use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, Mat, Par, Side};
+use faer::Mat;
 use nalgebra::{Matrix4, Point2, Vector2, Vector4};
 use std::cell::OnceCell;
 
@@ -158,192 +155,8 @@ pub struct SdLog {
     pub collision_limited: usize,
 }
 
-/// The fixed sparsity pattern of the 2n×2n Hessian (dof `2v + c`, full symmetric storage)
-/// and the value slot of every triangle-local entry.
-struct Pattern {
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
-    /// 36 slots per triangle, row-major over local dofs `2k + c`.
-    tri_slots: Vec<[u32; 36]>,
-    /// Slots of the 2×2 diagonal block of each vertex.
-    diag_slots: Vec<[u32; 4]>,
-}
-
-impl Pattern {
-    fn new(n: usize, tris: &[[VertexId; 3]]) -> Pattern {
-        let mut adj: Vec<Vec<usize>> = (0..n).map(|v| vec![v]).collect();
-        for t in tris {
-            for a in t {
-                for b in t {
-                    adj[a.idx()].push(b.idx());
-                }
-            }
-        }
-        for a in &mut adj {
-            a.sort_unstable();
-            a.dedup();
-        }
-        let mut col_ptr = Vec::with_capacity(2 * n + 1);
-        let mut row_idx = Vec::new();
-        col_ptr.push(0);
-        for a in &adj {
-            for _c in 0..2 {
-                for &w in a {
-                    row_idx.push(2 * w);
-                    row_idx.push(2 * w + 1);
-                }
-                col_ptr.push(row_idx.len());
-            }
-        }
-        let slot = |row: usize, col: usize| -> u32 {
-            let (s, e) = (col_ptr[col], col_ptr[col + 1]);
-            // The pattern contains every (row, col) asked for by construction.
-            let k = row_idx[s..e].binary_search(&row).unwrap_or(0);
-            (s + k) as u32
-        };
-        // Column `2a + c` lists rows `2w, 2w + 1` for the sorted neighbours `w` of `a`, so the
-        // slot of row `2b + r` is `col_ptr[2a + c] + 2·(position of b in adj[a]) + r`: one
-        // search per vertex pair instead of one per entry.
-        let tri_slots = tris
-            .iter()
-            .map(|t| {
-                let mut s = [0u32; 36];
-                for k1 in 0..3 {
-                    let a = t[k1].idx();
-                    for k2 in 0..3 {
-                        let b = t[k2].idx();
-                        // By construction b is in adj[a].
-                        let pos = adj[a].binary_search(&b).unwrap_or(0);
-                        for c in 0..2 {
-                            let base = col_ptr[2 * a + c] + 2 * pos;
-                            for r in 0..2 {
-                                // Entry (row 2b + r, column 2a + c) at local (2k2 + r, 2k1 + c).
-                                s[(2 * k2 + r) * 6 + 2 * k1 + c] = (base + r) as u32;
-                            }
-                        }
-                    }
-                }
-                s
-            })
-            .collect();
-        let diag_slots = (0..n)
-            .map(|v| {
-                [
-                    slot(2 * v, 2 * v),
-                    slot(2 * v + 1, 2 * v),
-                    slot(2 * v, 2 * v + 1),
-                    slot(2 * v + 1, 2 * v + 1),
-                ]
-            })
-            .collect();
-        Pattern {
-            col_ptr,
-            row_idx,
-            tri_slots,
-            diag_slots,
-        }
-    }
-}
-
 /// Overlap repair iterations without fewer crossing boundary edges before it gives up.
 const REPAIR_PATIENCE: usize = 6;
-
-/// Hessian dimension (2 × vertices) from which the supernodal Cholesky is forced.
-pub(super) const SUPERNODAL_MIN_DIM: usize = 2000;
-
-/// What the Newton iterations on one disk share: the Hessian pattern and its symbolic
-/// Cholesky factorisation (AMD ordering). Built once per disk and reused by the overlap
-/// repair and the certified optimisation (~3.5 ms on a 5,000-face patch).
-struct Setup {
-    pat: Pattern,
-    symbolic: SymbolicCholesky<usize>,
-}
-
-impl Setup {
-    fn new(disk: &TriMesh) -> Result<Setup, ParamError> {
-        let pat = Pattern::new(disk.n_vertices(), &disk.triangles);
-        let dim = 2 * disk.n_vertices();
-        let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
-        // One symbolic factorisation for all iterations. Sequential (`Par::Seq`): the result
-        // must not depend on the thread count (same seed → same bytes), and small
-        // factorisations gain little from threads.
-        let symbolic = factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), {
-            // Supernodal from SUPERNODAL_MIN_DIM dofs: faer's automatic choice picks the
-            // simplicial kernel for these 2D-mesh Hessians, measured ~25–50% slower per
-            // factorisation on 5k–15k-face cover patches (the 2×2 vertex blocks make dense
-            // supernodes); small patches keep the automatic choice.
-            let mut p = CholeskySymbolicParams::default();
-            if dim >= SUPERNODAL_MIN_DIM {
-                p.supernodal_flop_ratio_threshold = SupernodalThreshold::FORCE_SUPERNODAL;
-            }
-            p
-        })
-        .map_err(|e| ParamError::Solver(format!("symbolic Cholesky: {e:?}")))?;
-        Ok(Setup { pat, symbolic })
-    }
-
-    /// The shared setup, built on first use.
-    fn get<'a>(cell: &'a OnceCell<Setup>, disk: &TriMesh) -> Result<&'a Setup, ParamError> {
-        if let Some(s) = cell.get() {
-            return Ok(s);
-        }
-        let s = Setup::new(disk)?;
-        Ok(cell.get_or_init(|| s))
-    }
-}
-
-/// [`super::lscm()`] through the shared Newton [`Setup`]: the LSCM normal matrix has the
-/// Hessian's pattern, so it is assembled into the pattern's slots (pinned dofs become
-/// identity rows) and factorised with the symbolic factorisation the optimisation reuses,
-/// instead of sorting triplets and ordering a second time. Same pins, same minimiser.
-fn lscm_shared(
-    disk: &TriMesh,
-    boundary: &[VertexId],
-    setup: &Setup,
-) -> Result<Vec<Point2<f64>>, ParamError> {
-    let (p0, p1, dist) = super::lscm::pins(disk, boundary)?;
-    let n = disk.n_vertices();
-    let dim = 2 * n;
-    let pat = &setup.pat;
-    let mut fixed = vec![None; dim];
-    fixed[2 * p0.idx()] = Some(0.0);
-    fixed[2 * p0.idx() + 1] = Some(0.0);
-    fixed[2 * p1.idx()] = Some(dist);
-    fixed[2 * p1.idx() + 1] = Some(0.0);
-    let mut vals = vec![0.0; pat.row_idx.len()];
-    let mut sol = Mat::<f64>::zeros(dim, 1);
-    for (ti, (t, fr)) in disk.triangles.iter().zip(triangle_frames(disk)).enumerate() {
-        if fr.area <= 0.0 {
-            continue;
-        }
-        let (r1, r2) = super::lscm::conformal_rows(&fr.grad);
-        let dof = |l: usize| 2 * t[l / 2].idx() + l % 2;
-        for l1 in 0..6 {
-            if fixed[dof(l1)].is_some() {
-                continue;
-            }
-            for l2 in 0..6 {
-                let w = fr.area * (r1[l1] * r1[l2] + r2[l1] * r2[l2]);
-                match fixed[dof(l2)] {
-                    Some(x) => sol[(dof(l1), 0)] -= w * x,
-                    None => vals[pat.tri_slots[ti][l1 * 6 + l2] as usize] += w,
-                }
-            }
-        }
-    }
-    for (d, x) in fixed.iter().enumerate() {
-        if let Some(x) = x {
-            vals[pat.diag_slots[d / 2][if d % 2 == 0 { 0 } else { 3 }] as usize] = 1.0;
-            sol[(d, 0)] = *x;
-        }
-    }
-    let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
-    super::lscm::llt_solve(&setup.symbolic, SparseColMatRef::new(sym, &vals), &mut sol)?;
-    let uv: Vec<Point2<f64>> = (0..n)
-        .map(|v| Point2::new(sol[(2 * v, 0)], sol[(2 * v + 1, 0)]))
-        .collect();
-    super::lscm::finite_lscm(uv)
-}
 
 /// Energy, gradient and projected Hessian of one triangle with respect to `vec(F)`
 /// (row-major `a, b, c, d`). `None` when `det F ≤ 0` (infinite energy).
@@ -646,7 +459,6 @@ impl Problem<'_> {
                     grad[2 * t[k].idx() + i] += w * (gf[2 * i] * g[k][0] + gf[2 * i + 1] * g[k][1]);
                 }
             }
-            let slots = &pat.tri_slots[ti];
             // Block (i, m) of the 6×6 Hessian over corners: G · H_F[2i.., 2m..] · Gᵀ (3×3).
             for i in 0..2 {
                 for m in 0..2 {
@@ -661,7 +473,7 @@ impl Problem<'_> {
                         ];
                         for l in 0..3 {
                             let v = tk[0] * g[l][0] + tk[1] * g[l][1];
-                            vals[slots[(2 * k + i) * 6 + 2 * l + m] as usize] += v;
+                            vals[pat.tri_slot(ti, 2 * k + i, 2 * l + m)] += v;
                         }
                     }
                 }
@@ -679,11 +491,7 @@ impl Problem<'_> {
             for (v, gv) in tri_gap_grad(uv, p, a, b) {
                 grad[2 * v] += d1 * gv.x;
                 grad[2 * v + 1] += d1 * gv.y;
-                let s = &pat.diag_slots[v];
-                vals[s[0] as usize] += d2 * gv.x * gv.x;
-                vals[s[1] as usize] += d2 * gv.y * gv.x;
-                vals[s[2] as usize] += d2 * gv.x * gv.y;
-                vals[s[3] as usize] += d2 * gv.y * gv.y;
+                pat.add_diag_outer(vals, v, d2, [gv.x, gv.y]);
             }
         }
         // Overlap repair: w ((s + margin) / margin)² while positive, s the signed distance of
@@ -701,12 +509,7 @@ impl Problem<'_> {
             for (v, c) in [(p, 1.0), (a, -(1.0 - u)), (b, -u)] {
                 grad[2 * v] += d1 * c * nl.x;
                 grad[2 * v + 1] += d1 * c * nl.y;
-                let h = 2.0 * k * c * c;
-                let s = &pat.diag_slots[v];
-                vals[s[0] as usize] += h * nl.x * nl.x;
-                vals[s[1] as usize] += h * nl.y * nl.x;
-                vals[s[2] as usize] += h * nl.x * nl.y;
-                vals[s[3] as usize] += h * nl.y * nl.y;
+                pat.add_diag_outer(vals, v, 2.0 * k * c * c, [nl.x, nl.y]);
             }
         }
         Ok(())
@@ -1002,7 +805,7 @@ fn newton(
     uv0: &[Point2<f64>],
     options: &SdOptions,
     certified: bool,
-    setup: &OnceCell<Setup>,
+    system: &OnceCell<VertexSystem>,
 ) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
     let n = disk.n_vertices();
     let frames = triangle_frames(disk);
@@ -1044,18 +847,13 @@ fn newton(
             dt
         }
     };
-    let Setup { pat, symbolic } = Setup::get(setup, disk)?;
+    let system = VertexSystem::get(system, disk).map_err(ParamError::Solver)?;
+    let pat = &system.pattern;
     let dim = 2 * n;
-    let sym = SymbolicSparseColMatRef::new_checked(dim, dim, &pat.col_ptr, None, &pat.row_idx);
-    let mut l_values = vec![0.0; symbolic.len_val()];
-    let mut mem = MemBuffer::new(
-        symbolic
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
-    );
-    let mut shifted = vec![0.0; pat.row_idx.len()];
+    let mut llt = Llt::new(system);
+    let mut shifted = vec![0.0; pat.nnz()];
     log.time_ms[0] += lap();
-    let mut vals = vec![0.0; pat.row_idx.len()];
+    let mut vals = vec![0.0; pat.nnz()];
     let mut grad = vec![0.0; dim];
     if prob.pen_w > 0.0 {
         add_penetrations(&uv, boundary, &mut prob);
@@ -1080,39 +878,21 @@ fn newton(
         log.time_ms[1] += lap();
         // Regularise the projected Hessian (translations and, at an isometry, rotations are
         // in its null space); grow the shift until the Cholesky factorisation succeeds.
-        let trace: f64 = (0..dim)
-            .map(|v| vals[pat.diag_slots[v / 2][if v % 2 == 0 { 0 } else { 3 }] as usize])
-            .sum();
+        let trace: f64 = (0..dim).map(|v| vals[pat.diag_slot(v)]).sum();
         let mean_diag = trace / dim as f64;
         let mut solve = |log: &mut SdLog| -> Result<Vec<f64>, ParamError> {
             let mut mu = 1e-8 * mean_diag;
             for _ in 0..8 {
                 shifted.copy_from_slice(&vals);
-                for vv in 0..n {
-                    shifted[pat.diag_slots[vv][0] as usize] += mu;
-                    shifted[pat.diag_slots[vv][3] as usize] += mu;
+                for d in 0..dim {
+                    shifted[pat.diag_slot(d)] += mu;
                 }
-                let mat = SparseColMatRef::new(sym, &shifted);
                 log.factorizations += 1;
-                if let Ok(llt) = symbolic.factorize_numeric_llt::<f64>(
-                    &mut l_values,
-                    mat,
-                    Side::Lower,
-                    Default::default(),
-                    Par::Seq,
-                    MemStack::new(&mut mem),
-                    Default::default(),
-                ) {
-                    let mut sol = Mat::<f64>::zeros(dim, 1);
-                    for i in 0..dim {
-                        sol[(i, 0)] = -grad[i];
-                    }
-                    llt.solve_in_place_with_conj(
-                        Conj::No,
-                        sol.as_mut(),
-                        Par::Seq,
-                        MemStack::new(&mut mem),
-                    );
+                let mut sol = Mat::<f64>::zeros(dim, 1);
+                for i in 0..dim {
+                    sol[(i, 0)] = -grad[i];
+                }
+                if llt.solve(&shifted, &mut sol).is_ok() {
                     return Ok((0..dim).map(|i| sol[(i, 0)]).collect());
                 }
                 mu *= 100.0;
@@ -1277,19 +1057,21 @@ pub fn initial_map(
     )
 }
 
-/// [`initial_map`] with the Newton setup shared with the optimisation that follows; fills
+/// [`initial_map`] with the linear system shared with the optimisation that follows; fills
 /// the start-up part of `prof`.
 fn initial_map_with(
     disk: &TriMesh,
     boundary: &[VertexId],
     options: &SdOptions,
-    setup: &OnceCell<Setup>,
+    system: &OnceCell<VertexSystem>,
     prof: &mut SdProfile,
 ) -> Result<(Vec<Point2<f64>>, InitialMap), ParamError> {
     let clock = std::time::Instant::now();
     let ms = |c: std::time::Instant| c.elapsed().as_secs_f64() * 1e3;
     if options.free_boundary_init {
-        let lscm = Setup::get(setup, disk).and_then(|s| lscm_shared(disk, boundary, s));
+        let lscm = VertexSystem::get(system, disk)
+            .map_err(ParamError::Solver)
+            .and_then(|s| lscm_on(disk, boundary, s));
         if let Ok(mut uv) = lscm {
             scale_to_area(disk, &mut uv);
             let lscm_ok = certify(disk, &uv, boundary).is_ok();
@@ -1303,7 +1085,7 @@ fn initial_map_with(
                     max_iters: options.repair_iters,
                     ..*options
                 };
-                let repaired = newton(disk, boundary, &uv, &o, false, setup);
+                let repaired = newton(disk, boundary, &uv, &o, false, system);
                 let mut out = None;
                 if let Ok((mut r, log)) = repaired {
                     prof.repair = Some(log);
@@ -1368,15 +1150,15 @@ impl SymmetricDirichlet {
         validate_disk(disk, boundary)?;
         let mut prof = SdProfile::default();
         let clock = std::time::Instant::now();
-        let setup = OnceCell::new();
-        let (uv0, kind) = initial_map_with(disk, boundary, &self.options, &setup, &mut prof)?;
+        let system = OnceCell::new();
+        let (uv0, kind) = initial_map_with(disk, boundary, &self.options, &system, &mut prof)?;
         prof.init = Some(kind);
         prof.init_ms = clock.elapsed().as_secs_f64() * 1e3;
         let clock = std::time::Instant::now();
         // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
         // finite float energy, or a failed factorisation), the certified Tutte map is returned.
         // `initial_map_with` certified `uv0`.
-        let (mut uv, log) = match newton(disk, boundary, &uv0, &self.options, true, &setup) {
+        let (mut uv, log) = match newton(disk, boundary, &uv0, &self.options, true, &system) {
             Ok(r) => r,
             Err(_) => (
                 uv0,
@@ -1553,41 +1335,6 @@ mod tests {
         let (sd, (n, _)) = signed_gap(&uv, 3, 5, 6).unwrap();
         assert!((sd - 0.5).abs() < 1e-12, "{sd}");
         assert!((n - Vector2::new(-1.0, 0.0)).norm() < 1e-12, "{n}");
-    }
-
-    #[test]
-    fn shared_lscm_equals_the_public_lscm() {
-        let mut disk = crate::mesh::generators::cylinder_piece(1.0, 2.0, 1.0, 8, 3);
-        // Bend it a little more so the map is not a plain unrolling.
-        for p in &mut disk.positions {
-            p.z += 0.1 * p.x * p.y;
-        }
-        let boundary = super::super::disk_boundary(&disk).unwrap();
-        let a = super::super::lscm(&disk, &boundary).unwrap();
-        let b = lscm_shared(&disk, &boundary, &Setup::new(&disk).unwrap()).unwrap();
-        let err = a
-            .iter()
-            .zip(&b)
-            .map(|(p, q)| (p - q).norm())
-            .fold(0.0, f64::max);
-        assert!(err < 1e-9, "{err}");
-    }
-
-    #[test]
-    fn triangle_slots_address_their_entries() {
-        let disk = crate::mesh::generators::disk(1.0, 5, 5);
-        let pat = Pattern::new(disk.n_vertices(), &disk.triangles);
-        for (t, slots) in disk.triangles.iter().zip(&pat.tri_slots) {
-            for l1 in 0..6 {
-                for l2 in 0..6 {
-                    let row = 2 * t[l1 / 2].idx() + l1 % 2;
-                    let col = 2 * t[l2 / 2].idx() + l2 % 2;
-                    let k = slots[l1 * 6 + l2] as usize;
-                    assert!(pat.col_ptr[col] <= k && k < pat.col_ptr[col + 1]);
-                    assert_eq!(pat.row_idx[k], row);
-                }
-            }
-        }
     }
 
     #[test]
