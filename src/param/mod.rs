@@ -3,13 +3,13 @@
 
 mod distortion;
 mod lscm;
-mod sdirichlet;
+mod sd;
 mod sparse;
 mod tutte;
 
 pub use distortion::{distortion, triangle_frames, TriangleFrame};
 pub use lscm::lscm;
-pub use sdirichlet::{
+pub use sd::{
     initial_map, optimize_locally_injective, optimize_with_log, InitialMap, SdLog, SdOptions,
     SdProfile, SymmetricDirichlet,
 };
