@@ -16,10 +16,7 @@ use nalgebra::Point2;
 /// The two pinned vertices of [`lscm`] and their 3D distance: a boundary vertex and the
 /// boundary vertex farthest from it, then the one farthest from that (two sweeps of the
 /// diameter heuristic).
-fn pins(
-    disk: &TriMesh,
-    boundary: &[VertexId],
-) -> Result<(VertexId, VertexId, f64), ParamError> {
+fn pins(disk: &TriMesh, boundary: &[VertexId]) -> Result<(VertexId, VertexId, f64), ParamError> {
     if boundary.len() < 3 {
         return Err(ParamError::NotADisk(format!(
             "boundary of {} vertices",
@@ -185,14 +182,20 @@ mod tests {
         for (t, fr) in m.triangles.iter().zip(triangle_frames(&m)) {
             let (r1, r2) = conformal_rows(&fr.grad);
             let u = |l: usize| uv[t[l / 2].idx()][l % 2];
-            let (s1, s2) = (0..6).fold((0.0, 0.0), |(a, b), l| (a + r1[l] * u(l), b + r2[l] * u(l)));
+            let (s1, s2) =
+                (0..6).fold((0.0, 0.0), |(a, b), l| (a + r1[l] * u(l), b + r2[l] * u(l)));
             for l in 0..6 {
                 let g = 2.0 * fr.area * (r1[l] * s1 + r2[l] * s2);
                 grad[2 * t[l / 2].idx() + l % 2] += g;
                 scale = scale.max((2.0 * fr.area * (r1[l].abs() + r2[l].abs())).abs());
             }
         }
-        let pinned = [2 * p0.idx(), 2 * p0.idx() + 1, 2 * p1.idx(), 2 * p1.idx() + 1];
+        let pinned = [
+            2 * p0.idx(),
+            2 * p0.idx() + 1,
+            2 * p1.idx(),
+            2 * p1.idx() + 1,
+        ];
         for (d, g) in grad.iter().enumerate() {
             if !pinned.contains(&d) {
                 assert!(g.abs() < 1e-10 * scale * dist, "dof {d}: {g}");

@@ -173,9 +173,13 @@ impl VertexSystem {
         if pattern.dim() >= SUPERNODAL_MIN_DIM {
             params.supernodal_flop_ratio_threshold = SupernodalThreshold::FORCE_SUPERNODAL;
         }
-        let symbolic =
-            factorize_symbolic_cholesky(pattern.symbolic(), Side::Lower, Default::default(), params)
-                .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.symbolic(),
+            Side::Lower,
+            Default::default(),
+            params,
+        )
+        .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
         Ok(VertexSystem { pattern, symbolic })
     }
 

@@ -135,7 +135,10 @@ mod tests {
             Point2::new(0.5, 0.05),
             Point2::new(0.0, 1.0),
         ];
-        let pos = uv.iter().map(|p| nalgebra::Point3::new(p.x, p.y, 0.0)).collect();
+        let pos = uv
+            .iter()
+            .map(|p| nalgebra::Point3::new(p.x, p.y, 0.0))
+            .collect();
         let disk = TriMesh::from_indices(pos, &[[0, 1, 3], [1, 2, 3], [0, 3, 4]]).unwrap();
         let boundary: Vec<VertexId> = (0..5).map(VertexId::new).collect();
         let bar = BoundaryBarrier {

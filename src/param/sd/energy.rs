@@ -179,7 +179,10 @@ mod tests {
             assert!((clamped - hp).norm() < 1e-8 * hp.norm(), "{f}");
             // The absolute-value filter puts |twist| on the same eigenvector.
             let (_, _, ha) = derivatives(&f, TwistFilter::Abs).unwrap();
-            assert!((ha * q - q * twist.abs()).norm() < 1e-8 * (1.0 + twist.abs()), "{f}");
+            assert!(
+                (ha * q - q * twist.abs()).norm() < 1e-8 * (1.0 + twist.abs()),
+                "{f}"
+            );
         }
     }
 }

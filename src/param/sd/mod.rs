@@ -7,7 +7,7 @@
 //! * Boundary barrier (ref. \[30\], Su et al.) on the triangle-inequality gap: [`barrier`].
 //! * The objective over the whole map, assembled on a sparsity pattern fixed at start with
 //!   one symbolic Cholesky reused every step (`super::sparse`): [`objective`].
-//! * Newton iterations and line search: [`newton`]; its step bounds (flip-free and
+//! * Newton iterations and line search: [`mod@newton`]; its step bounds (flip-free and
 //!   boundary-collision): [`bounds`].
 //! * Start: the free-boundary LSCM when certified; else the LSCM after the overlap repair
 //!   ([`repair`]) when that is certified; else the Tutte map ([`init`]). The repair steps are
@@ -78,7 +78,7 @@ pub struct SdOptions {
     /// penetrating boundary vertex `repair_margin` back out of the edge it crossed (no
     /// barrier, no certificate during the steps; stops early once certified, or when the
     /// number of crossing boundary edges has not fallen for 6 steps). The result is used
-    /// only if it passes the exact certificate, else the Tutte map \[30\]; 0 disables.
+    /// only if it passes the exact certificate, else the Tutte map; 0 disables \[30\].
     pub repair_iters: usize,
     /// Weight of one overlap-repair term relative to one average triangle's energy share
     /// (0: plain locally injective steps) \[100\].
@@ -149,7 +149,14 @@ pub fn optimize_with_log(
     options: &SdOptions,
 ) -> Result<(Vec<Point2<f64>>, SdLog), ParamError> {
     certify(disk, uv0, boundary)?;
-    newton(disk, boundary, uv0, options, Mode::Certified, &OnceCell::new())
+    newton(
+        disk,
+        boundary,
+        uv0,
+        options,
+        Mode::Certified,
+        &OnceCell::new(),
+    )
 }
 
 /// [`optimize_with_log`] without the global part: locally injective projected Newton (no
@@ -207,7 +214,14 @@ impl SymmetricDirichlet {
         // If the optimiser cannot run at all (e.g. a certified Tutte triangle too thin for a
         // finite float energy, or a failed factorisation), the certified start is returned
         // (`initial_map_with` certified it).
-        let optimized = newton(disk, boundary, &uv0, &self.options, Mode::Certified, &system);
+        let optimized = newton(
+            disk,
+            boundary,
+            &uv0,
+            &self.options,
+            Mode::Certified,
+            &system,
+        );
         let (mut uv, log) = optimized.unwrap_or_else(|_| {
             let log = SdLog {
                 fell_back: true,
