@@ -86,9 +86,6 @@ fn main() {
                     if let Some(x) = env("BD") {
                         sd.options.barrier_distance = x;
                     }
-                    if let Some(x) = env("DT") {
-                        sd.options.decrement_tol = x;
-                    }
                     if let Some(x) = env("COLL") {
                         sd.options.collision_bound = x > 0.0;
                     }
@@ -101,17 +98,8 @@ fn main() {
                     if let Some(x) = env("RW") {
                         sd.options.repair_weight = x;
                     }
-                    if let Some(x) = env("AB") {
-                        sd.options.adaptive_barrier = x;
-                    }
-                    if let Some(x) = env("SEED") {
-                        sd.options.adaptive_seed = x;
-                    }
                     if let Some(x) = env("RC") {
                         sd.options.repair_clearance = x;
-                    }
-                    if let Some(x) = env("AS") {
-                        sd.options.adaptive_shrink = x;
                     }
                     let r = sd.parameterize_profiled(&pm.mesh, &pm.boundary);
                     let ms = t.elapsed().as_secs_f64() * 1e3;
@@ -330,12 +318,9 @@ fn main() {
                 );
                 uv0 = b;
             }
-            // INIT=1: the parameterizer's own initial map (INIT=0: without the ellipse Tutte).
-            if let Ok(v) = std::env::var("INIT") {
-                let mut o = SdOptions {
-                    shaped_tutte_init: v != "0",
-                    ..Default::default()
-                };
+            // INIT=1: the parameterizer's own initial map.
+            if std::env::var("INIT").is_ok() {
+                let mut o = SdOptions::default();
                 if let Some(x) = env_usize("RI") {
                     o.repair_iters = x;
                 }
@@ -373,15 +358,6 @@ fn main() {
             }
             if let Some(x) = env("COLL") {
                 opts.collision_bound = x > 0.0;
-            }
-            if let Some(x) = env("CAB") {
-                opts.collision_active_below = x;
-            }
-            if let Some(x) = env("CR") {
-                opts.collision_rounds = x as usize;
-            }
-            if let Some(x) = env("CK") {
-                opts.collision_stiffness = x;
             }
             if let Some(x) = env("SF") {
                 opts.step_fraction = x;

@@ -6,25 +6,17 @@
 //! and falls back to the Tutte map otherwise.
 
 use super::distortion::triangle_frames;
+use super::sparse::{Llt, VertexSystem};
 use super::ParamError;
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky,
-};
-use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
-use faer::{Conj, Mat, Par, Side};
+use faer::Mat;
 use nalgebra::Point2;
 
 /// The two pinned vertices of [`lscm`] and their 3D distance: a boundary vertex and the
 /// boundary vertex farthest from it, then the one farthest from that (two sweeps of the
 /// diameter heuristic).
-pub(super) fn pins(
-    disk: &TriMesh,
-    boundary: &[VertexId],
-) -> Result<(VertexId, VertexId, f64), ParamError> {
+fn pins(disk: &TriMesh, boundary: &[VertexId]) -> Result<(VertexId, VertexId, f64), ParamError> {
     if boundary.len() < 3 {
         return Err(ParamError::NotADisk(format!(
             "boundary of {} vertices",
@@ -53,7 +45,7 @@ pub(super) fn pins(
 /// The rows of `a − d` and `b + c` of a triangle's Jacobian over its local dofs `2k + c`
 /// (`F_ij = Σ_k u_{k,i} g_k[j]`): the LSCM energy of the triangle is
 /// `A_t ((r1·u)² + (r2·u)²)`.
-pub(super) fn conformal_rows(g: &[[f64; 2]; 3]) -> ([f64; 6], [f64; 6]) {
+fn conformal_rows(g: &[[f64; 2]; 3]) -> ([f64; 6], [f64; 6]) {
     let mut r1 = [0.0; 6];
     let mut r2 = [0.0; 6];
     for k in 0..3 {
@@ -70,76 +62,76 @@ pub(super) fn conformal_rows(g: &[[f64; 2]; 3]) -> ([f64; 6], [f64; 6]) {
 /// with the two boundary vertices farthest apart in 3D pinned at their 3D distance.
 /// Solved by faer's sparse Cholesky. No certification, no area scaling.
 pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, ParamError> {
+    let pinned = pins(disk, boundary)?;
+    let system = VertexSystem::new(disk).map_err(ParamError::Solver)?;
+    solve_pinned(disk, pinned, &system)
+}
+
+/// [`lscm`] on the [`VertexSystem`] of `disk` that the symmetric Dirichlet optimisation
+/// reuses afterwards: the LSCM normal matrix has the Newton Hessian's pattern, so it costs
+/// one numeric factorisation and no second ordering.
+pub(super) fn lscm_on(
+    disk: &TriMesh,
+    boundary: &[VertexId],
+    system: &VertexSystem,
+) -> Result<Vec<Point2<f64>>, ParamError> {
+    solve_pinned(disk, pins(disk, boundary)?, system)
+}
+
+/// The LSCM normal equations assembled into the slots of `system`'s pattern, the pinned
+/// dofs as identity rows (their couplings moved to the right-hand side), so that the
+/// matrix keeps the full pattern and its symbolic factorisation applies.
+fn solve_pinned(
+    disk: &TriMesh,
+    (p0, p1, dist): (VertexId, VertexId, f64),
+    system: &VertexSystem,
+) -> Result<Vec<Point2<f64>>, ParamError> {
     let n = disk.n_vertices();
-    if boundary.len() < 3 {
-        return Err(ParamError::NotADisk(format!(
-            "boundary of {} vertices",
-            boundary.len()
-        )));
-    }
-    let (p0, p1, dist) = pins(disk, boundary)?;
-    const FIXED: usize = usize::MAX;
-    let mut uv = vec![Point2::origin(); n];
-    uv[p1.idx()] = Point2::new(dist, 0.0);
-    // Dof 2v + c; pinned dofs are moved to the right-hand side.
-    let mut index = vec![0usize; 2 * n];
-    index[2 * p0.idx()] = FIXED;
-    index[2 * p0.idx() + 1] = FIXED;
-    index[2 * p1.idx()] = FIXED;
-    index[2 * p1.idx() + 1] = FIXED;
-    let mut m = 0;
-    for x in index.iter_mut() {
-        if *x != FIXED {
-            *x = m;
-            m += 1;
-        }
-    }
-    let fixed_value = |dof: usize| -> f64 {
-        let p = uv[dof / 2];
-        if dof % 2 == 0 {
-            p.x
-        } else {
-            p.y
-        }
-    };
-    let mut trips = Vec::with_capacity(36 * disk.n_faces());
-    let mut rhs = Mat::<f64>::zeros(m, 1);
-    for (t, fr) in disk.triangles.iter().zip(triangle_frames(disk)) {
+    let dim = 2 * n;
+    let pat = &system.pattern;
+    let mut fixed = vec![None; dim];
+    fixed[2 * p0.idx()] = Some(0.0);
+    fixed[2 * p0.idx() + 1] = Some(0.0);
+    fixed[2 * p1.idx()] = Some(dist);
+    fixed[2 * p1.idx() + 1] = Some(0.0);
+    let mut vals = vec![0.0; pat.nnz()];
+    let mut sol = Mat::<f64>::zeros(dim, 1);
+    for (ti, (t, fr)) in disk.triangles.iter().zip(triangle_frames(disk)).enumerate() {
         if fr.area <= 0.0 {
             continue;
         }
         let (r1, r2) = conformal_rows(&fr.grad);
         let dof = |l: usize| 2 * t[l / 2].idx() + l % 2;
         for l1 in 0..6 {
-            let i = index[dof(l1)];
-            if i == FIXED {
+            if fixed[dof(l1)].is_some() {
                 continue;
             }
             for l2 in 0..6 {
                 let w = fr.area * (r1[l1] * r1[l2] + r2[l1] * r2[l2]);
-                match index[dof(l2)] {
-                    FIXED => rhs[(i, 0)] -= w * fixed_value(dof(l2)),
-                    j => trips.push(Triplet::new(i, j, w)),
+                match fixed[dof(l2)] {
+                    Some(x) => sol[(dof(l1), 0)] -= w * x,
+                    None => vals[pat.tri_slot(ti, l1, l2)] += w,
                 }
             }
         }
     }
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &trips)
-        .map_err(|e| ParamError::Solver(format!("assembling LSCM: {e:?}")))?;
-    let sol = cholesky_solve(a.as_ref(), rhs)?;
-    for v in 0..n {
-        for c in 0..2 {
-            let i = index[2 * v + c];
-            if i != FIXED {
-                uv[v][c] = sol[(i, 0)];
-            }
+    for (d, x) in fixed.iter().enumerate() {
+        if let Some(x) = x {
+            vals[pat.diag_slot(d)] = 1.0;
+            sol[(d, 0)] = *x;
         }
     }
-    finite_lscm(uv)
+    Llt::new(system)
+        .solve(&vals, &mut sol)
+        .map_err(|e| ParamError::Solver(format!("LSCM Cholesky: {e}")))?;
+    let uv: Vec<Point2<f64>> = (0..n)
+        .map(|v| Point2::new(sol[(2 * v, 0)], sol[(2 * v + 1, 0)]))
+        .collect();
+    finite(uv)
 }
 
 /// `uv` if every position is finite, else an error naming the first vertex that is not.
-pub(crate) fn finite_lscm(uv: Vec<Point2<f64>>) -> Result<Vec<Point2<f64>>, ParamError> {
+fn finite(uv: Vec<Point2<f64>>) -> Result<Vec<Point2<f64>>, ParamError> {
     match uv
         .iter()
         .position(|p| !(p.x.is_finite() && p.y.is_finite()))
@@ -149,54 +141,6 @@ pub(crate) fn finite_lscm(uv: Vec<Point2<f64>>) -> Result<Vec<Point2<f64>>, Para
         ))),
         None => Ok(uv),
     }
-}
-
-/// Solve `a x = rhs` (symmetric positive definite, full storage) by sparse Cholesky; the
-/// supernodal kernel is forced from the size where it wins for the 2D-mesh matrices of
-/// Sec. 3.3 (as for the Newton Hessian, `super::sdirichlet`).
-fn cholesky_solve(
-    a: SparseColMatRef<'_, usize, f64>,
-    mut rhs: Mat<f64>,
-) -> Result<Mat<f64>, ParamError> {
-    let err =
-        |what: &str, e: &dyn std::fmt::Debug| ParamError::Solver(format!("LSCM {what}: {e:?}"));
-    let mut params = CholeskySymbolicParams::default();
-    if a.nrows() >= super::sdirichlet::SUPERNODAL_MIN_DIM {
-        params.supernodal_flop_ratio_threshold = SupernodalThreshold::FORCE_SUPERNODAL;
-    }
-    let symbolic =
-        factorize_symbolic_cholesky(a.symbolic(), Side::Lower, Default::default(), params)
-            .map_err(|e| err("symbolic Cholesky", &e))?;
-    llt_solve(&symbolic, a, &mut rhs)?;
-    Ok(rhs)
-}
-
-/// Numeric Cholesky of `a` on its symbolic factorisation, then `rhs ← a⁻¹ rhs` (the LSCM
-/// solve; also used by the symmetric Dirichlet setup, which keeps one symbolic factorisation).
-pub(crate) fn llt_solve(
-    symbolic: &SymbolicCholesky<usize>,
-    a: SparseColMatRef<'_, usize, f64>,
-    rhs: &mut Mat<f64>,
-) -> Result<(), ParamError> {
-    let mut l_values = vec![0.0; symbolic.len_val()];
-    let mut mem = MemBuffer::new(
-        symbolic
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
-    );
-    let llt = symbolic
-        .factorize_numeric_llt::<f64>(
-            &mut l_values,
-            a,
-            Side::Lower,
-            Default::default(),
-            Par::Seq,
-            MemStack::new(&mut mem),
-            Default::default(),
-        )
-        .map_err(|e| ParamError::Solver(format!("LSCM Cholesky: {e:?}")))?;
-    llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), Par::Seq, MemStack::new(&mut mem));
-    Ok(())
 }
 
 #[cfg(test)]
@@ -218,5 +162,44 @@ mod tests {
         let r = distortion(&m, &uv);
         assert!(r.max_conformal < 1.0 + 1e-6, "{r:?}");
         assert!(r.max_area_distortion < 1e-6, "{r:?}");
+    }
+
+    #[test]
+    fn lscm_solves_the_normal_equations_with_the_pins_fixed() {
+        // A bent (non-developable) cylinder piece, so the minimum is not a similarity: the
+        // energy's gradient must vanish at every free dof, and the pins sit where placed.
+        let mut m = generators::cylinder_piece(1.0, 2.0, 1.0, 8, 3);
+        for p in &mut m.positions {
+            p.z += 0.1 * p.x * p.y;
+        }
+        let b = disk_boundary(&m).unwrap();
+        let uv = lscm(&m, &b).unwrap();
+        let (p0, p1, dist) = pins(&m, &b).unwrap();
+        assert_eq!(uv[p0.idx()], Point2::new(0.0, 0.0));
+        assert_eq!(uv[p1.idx()], Point2::new(dist, 0.0));
+        let mut grad = vec![0.0; 2 * m.n_vertices()];
+        let mut scale = 0.0f64;
+        for (t, fr) in m.triangles.iter().zip(triangle_frames(&m)) {
+            let (r1, r2) = conformal_rows(&fr.grad);
+            let u = |l: usize| uv[t[l / 2].idx()][l % 2];
+            let (s1, s2) =
+                (0..6).fold((0.0, 0.0), |(a, b), l| (a + r1[l] * u(l), b + r2[l] * u(l)));
+            for l in 0..6 {
+                let g = 2.0 * fr.area * (r1[l] * s1 + r2[l] * s2);
+                grad[2 * t[l / 2].idx() + l % 2] += g;
+                scale = scale.max((2.0 * fr.area * (r1[l].abs() + r2[l].abs())).abs());
+            }
+        }
+        let pinned = [
+            2 * p0.idx(),
+            2 * p0.idx() + 1,
+            2 * p1.idx(),
+            2 * p1.idx() + 1,
+        ];
+        for (d, g) in grad.iter().enumerate() {
+            if !pinned.contains(&d) {
+                assert!(g.abs() < 1e-10 * scale * dist, "dof {d}: {g}");
+            }
+        }
     }
 }

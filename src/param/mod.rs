@@ -4,18 +4,17 @@
 mod distortion;
 mod lscm;
 mod registry;
-mod sdirichlet;
-mod shaped;
+mod sd;
+mod sparse;
 mod tutte;
 
 pub use distortion::{distortion, triangle_frames, TriangleFrame};
 pub use lscm::lscm;
 pub use registry::{parameterizer, PARAMETERIZERS};
-pub use sdirichlet::{
+pub use sd::{
     initial_map, optimize_locally_injective, optimize_with_log, InitialMap, SdLog, SdOptions,
     SdProfile, SymmetricDirichlet,
 };
-pub use shaped::ellipse_boundary;
 pub use tutte::{circle_boundary, scale_to_area, tutte_embedding, Tutte, TutteWeights};
 
 use crate::ids::VertexId;

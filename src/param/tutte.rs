@@ -3,12 +3,12 @@
 //! neighbours. With positive weights and a convex boundary the map is bijective (Tutte 1963,
 //! Floater 2003); in floating point it is certified by `certify_bijective` anyway.
 
+use super::sparse::{solve_triplets, Factorization};
 use super::{certify, distortion, validate_disk, ParamError, Parameterization, Parameterizer};
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
-use faer::linalg::solvers::Solve;
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Side};
+use faer::sparse::Triplet;
+use faer::Mat;
 use nalgebra::Point2;
 use std::f64::consts::PI;
 
@@ -200,20 +200,13 @@ pub fn tutte_embedding(
             jj => trips.push(Triplet::new(ii, jj, -w)),
         }
     }
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(n_free, n_free, &trips)
-        .map_err(|e| ParamError::Solver(format!("assembling the Tutte Laplacian: {e:?}")))?;
-    // faer's high-level solvers use its global parallelism, which is sequential because faer
-    // is built without its `rayon` feature (Cargo.toml): the map, and so the output bytes, do
-    // not depend on the thread count. Enabling that feature would need `Par::Seq` here.
-    let sol = if weights_kind == TutteWeights::MeanValue {
-        a.sp_lu()
-            .map_err(|e| ParamError::Solver(format!("Tutte LU: {e:?}")))?
-            .solve(&rhs)
+    let how = if weights_kind == TutteWeights::MeanValue {
+        Factorization::Lu
     } else {
-        a.sp_cholesky(Side::Lower)
-            .map_err(|e| ParamError::Solver(format!("Tutte Cholesky: {e:?}")))?
-            .solve(&rhs)
+        Factorization::Cholesky
     };
+    let sol = solve_triplets(n_free, &trips, &rhs, how)
+        .map_err(|e| ParamError::Solver(format!("Tutte Laplacian: {e}")))?;
     for v in 0..n {
         let i = index[v];
         if i != FIXED {
