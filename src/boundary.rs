@@ -200,6 +200,25 @@ impl BoundaryCurves {
         a[i] + (a[i + 1] - a[i]) * p.t
     }
 
+    /// The vertices of loop `l` whose arc length lies strictly between `a` and `b` (`a ≤ b`,
+    /// both possibly beyond the loop's length: taken around the loop).
+    pub fn vertices_between(&self, l: usize, a: f64, b: f64) -> impl Iterator<Item = VertexId> + '_ {
+        let arc = &self.arc[l];
+        let lp = &self.loops[l];
+        let total = *arc.last().unwrap_or(&0.0);
+        let m = lp.len();
+        // Whole turns of the loop the interval may cover, each vertex at arc[i] + k·total.
+        let turns = if total > 0.0 { (b / total).floor() as i64 + 1 } else { 0 };
+        let first = if total > 0.0 { (a / total).floor() as i64 } else { 0 };
+        (first..turns.max(first))
+            .flat_map(move |k| (0..m).map(move |i| (k, i)))
+            .filter(move |&(k, i)| {
+                let s = arc[i] + k as f64 * total;
+                s > a && s < b
+            })
+            .map(move |(_, i)| lp[i])
+    }
+
     /// The point of loop `l` at arc length `s` (taken modulo the loop's length).
     pub fn at_arc(&self, l: usize, s: f64) -> CurvePoint {
         let a = &self.arc[l];

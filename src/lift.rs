@@ -9,6 +9,7 @@
 //! every vertex lies on the *input* surface even after several patches have replaced chords
 //! of it (see paper-notes.md, "Mapping back").
 
+use crate::boundary::CurvePoint;
 use crate::ids::VertexId;
 use crate::mesh::{SurfaceLocation, TriMesh};
 use crate::remesh2d::PlanarMesh;
@@ -41,8 +42,26 @@ pub enum LiftError {
     },
 }
 
+/// How a vertex of the planar domain maps back: a vertex of the patch (its local id), or a
+/// new point on the input's boundary curves, placed there exactly
+/// ([`crate::boundary::BoundaryCurves::position`]).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum DomainVertex {
+    /// A vertex of the patch.
+    Patch(u32),
+    /// A new point on a boundary curve.
+    Curve {
+        /// Its position (on the curve, exactly).
+        position: Point3<f64>,
+        /// Its location on the reference surface.
+        location: SurfaceLocation,
+        /// Its point on the curve.
+        point: CurvePoint,
+    },
+}
+
 /// The patch as the lifting step sees it: its initial 2D mesh and the 3D positions of the
-/// same vertices.
+/// same vertices, and what each vertex of the planar domain is.
 pub struct PatchFrame<'a> {
     /// Local triangles (indices into `positions` / the parameterization).
     pub triangles: &'a [[VertexId; 3]],
@@ -50,6 +69,8 @@ pub struct PatchFrame<'a> {
     pub positions: &'a [Point3<f64>],
     /// Local → working-mesh vertex id.
     pub to_global: &'a [VertexId],
+    /// Planar-domain vertex → what it is (the planar remesher's `origin` indexes these).
+    pub domain: &'a [DomainVertex],
 }
 
 /// Lift `planar` to 3D: boundary (origin) vertices become [`PatchVertex::Existing`], new
@@ -67,17 +88,33 @@ pub fn lift(
     let mut repl = Replacement::default();
     for (i, p) in planar.points.iter().enumerate() {
         match planar.origin.get(i).copied().flatten() {
-            Some(o) => {
-                let g = frame
-                    .to_global
-                    .get(o as usize)
-                    .ok_or(LiftError::BadOrigin {
+            Some(o) => match frame.domain.get(o as usize) {
+                Some(DomainVertex::Patch(l)) => {
+                    let g = frame.to_global.get(*l as usize).ok_or(LiftError::BadOrigin {
                         index: i,
                         origin: o,
                         n: n_local,
                     })?;
-                map.push(PatchVertex::Existing(*g));
-            }
+                    map.push(PatchVertex::Existing(*g));
+                }
+                Some(DomainVertex::Curve {
+                    position,
+                    location,
+                    point,
+                }) => {
+                    repl.new_positions.push(*position);
+                    repl.new_locations.push(*location);
+                    repl.new_curve.push(Some(*point));
+                    map.push(PatchVertex::New((repl.new_positions.len() - 1) as u32));
+                }
+                None => {
+                    return Err(LiftError::BadOrigin {
+                        index: i,
+                        origin: o,
+                        n: frame.domain.len(),
+                    })
+                }
+            },
             None => {
                 let (t, b) = locate(p).ok_or(LiftError::OutsideDomain {
                     index: i,
@@ -91,6 +128,7 @@ pub fn lift(
                 let loc = project(&Point3::from(q));
                 repl.new_positions.push(loc.position(reference));
                 repl.new_locations.push(loc);
+                repl.new_curve.push(None);
                 map.push(PatchVertex::New((repl.new_positions.len() - 1) as u32));
             }
         }
@@ -121,10 +159,12 @@ mod tests {
         )
         .expect("valid");
         let to_global = [VertexId(0), VertexId(1), VertexId(2)];
+        let domain: Vec<DomainVertex> = (0..3).map(DomainVertex::Patch).collect();
         let frame = PatchFrame {
             triangles: &reference.triangles,
             positions: &reference.positions,
             to_global: &to_global,
+            domain: &domain,
         };
         // Planar output: the three corners plus a centre vertex, fanned.
         let planar = PlanarMesh {

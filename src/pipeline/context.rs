@@ -5,6 +5,7 @@ use super::error::PipelineError;
 use super::options::Stages;
 use super::records::{Certificate, Fallbacks, PatchRecord, Progress, StageTimes};
 use super::sizing::Plan;
+use crate::boundary::BoundaryCurves;
 use crate::features::FeatureLines;
 use crate::fidelity::VertexFactors;
 use crate::ids::{EdgeKey, PatchId, VertexId};
@@ -44,6 +45,8 @@ pub struct RunContext<'a> {
     /// `corners[v]`: input vertex `v` is kept as a corner (its working-mesh id is stable;
     /// new vertices are never corners).
     pub corners: Vec<bool>,
+    /// The input's boundary curves, with their corners.
+    pub curves: BoundaryCurves,
 }
 
 impl<'a> RunContext<'a> {
@@ -65,7 +68,14 @@ impl<'a> RunContext<'a> {
             Some(d) => crate::patches::corner_vertices(reference, &reference_topology, d),
             None => Vec::new(),
         };
+        let curves = BoundaryCurves::new(
+            reference,
+            &reference_topology,
+            o.boundary.corner_angle,
+            o.corner_defect,
+        );
         RunContext {
+            curves,
             quality_field: field,
             plan,
             stages,
@@ -136,6 +146,9 @@ impl LoopState {
     pub fn new(ctx: &RunContext<'_>) -> Result<LoopState, PipelineError> {
         let reference = ctx.quality_field.reference();
         let mut work = WorkingMesh::from_reference(reference);
+        for v in reference.vertices() {
+            work.curve[v.idx()] = ctx.curves.point_at_vertex(v);
+        }
         let features = crate::features::split_to_target(
             &mut work,
             reference,

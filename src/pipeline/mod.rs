@@ -25,6 +25,7 @@
 //! the loop), `records.rs` (report types), `error.rs`, `debug.rs` (offending patches written
 //! out), `remesher.rs` (the whole job).
 
+mod chains;
 mod context;
 mod debug;
 mod error;

@@ -1,5 +1,6 @@
 //! Options of Algorithm 1 and the research extension points it runs.
 
+use crate::boundary::BoundaryOptions;
 use crate::fidelity::FidelityOptions;
 use crate::param::{Parameterizer, SymmetricDirichlet};
 use crate::patches::{ConePatches, PatchStrategy};
@@ -62,6 +63,9 @@ pub struct RemeshOptions {
     /// edges of the output (no patch crosses them, no pass moves or flips them). `None`
     /// keeps none (the paper). Default `None`.
     pub feature_angle: Option<f64>,
+    /// The input's boundary (ours, [`crate::boundary`]): resampled to the metric on the input's
+    /// boundary curves, corners kept (default), or kept vertex for vertex.
+    pub boundary: BoundaryOptions,
     /// Whether to run the coarse-input profile ([`RemeshOptions::coarse_profile`]): `Auto`
     /// (default) runs it when the distance tolerance rather than the metric sets the output's
     /// size: the a-priori fidelity scaling multiplies the expected face count
@@ -104,6 +108,7 @@ impl Default for RemeshOptions {
             corner_defect: Some(1.0),
             feature_angle: None,
             coarse_input: CoarseInput::Auto,
+            boundary: BoundaryOptions::default(),
         }
     }
 }
@@ -139,6 +144,12 @@ impl RemeshOptions {
                     "corner angle defect must be a positive number of radians, got {d}"
                 ));
             }
+        }
+        let b = self.boundary.corner_angle;
+        if !(b.is_finite() && b > 0.0 && b <= 180.0) {
+            return Err(format!(
+                "boundary corner angle must be in (0, 180] degrees, got {b}"
+            ));
         }
         if let Some(a) = self.feature_angle {
             if !(a.is_finite() && a > 0.0 && a < 180.0) {

@@ -77,6 +77,8 @@ pub struct Certificate {
     pub input_self_intersecting_pairs: Option<usize>,
     /// Patches whose parameterizer fell back to its last certified iterate.
     pub param_fallbacks: usize,
+    /// Free boundary chains resampled on the input's boundary curves.
+    pub chains: usize,
 }
 
 /// Per-patch record.

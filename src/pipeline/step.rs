@@ -16,7 +16,8 @@ use crate::fidelity::{self, PatchVertices, Refined, RoundOutput, RoundsSetup, Ve
 use crate::ids::{FaceId, PatchId};
 use crate::invariants::{self, InvariantError};
 use crate::lift::{lift, PatchFrame};
-use crate::mesh::{PlanarDomain, Topology};
+use super::chains::{self, PatchDomain};
+use crate::mesh::Topology;
 use crate::param::DistortionReport;
 use crate::patches::{extract_patch, interior_corner, interior_feature, Patch, PatchMesh};
 use crate::remesh2d::{pullback_corners, transfer_metric, PlanarMetricField, TransferMethod};
@@ -283,11 +284,17 @@ fn attempt(
         &view.work.locations,
     );
     let transfer = Transferred::new(ctx, &disk, &param.uv, &metrics3d)?;
+    // The free boundary chains resampled on the input's curves, in the first round's metric.
+    let round0 = transfer
+        .field(&transfer.metrics, &transfer.metrics.iter().map(|m| m.trace()).collect::<Vec<_>>())
+        .map_err(AttemptFailure::at(Stage::MetricTransfer))?;
+    let domain = chains::patch_domain(ctx, view.work, view.topo, &disk, &param.uv, &round0);
+    counters.cert.chains += domain.chains;
     counters.times.transfer += t0.elapsed().as_secs_f64();
 
     // (d) planar remeshing with the patch boundary fixed, certified, and (e) mapping back,
     // repeated by the fidelity control while the lifted patch deviates from the reference.
-    let refined = remesh_and_lift(ctx, &disk, &transfer, view.factors, rng, counters)?;
+    let refined = remesh_and_lift(ctx, &disk, &transfer, &domain, view.factors, rng, counters)?;
 
     // The candidate's new faces, certified before the working mesh is touched.
     let t0 = Instant::now();
@@ -320,7 +327,9 @@ fn attempt(
 /// The patch in the plane: the parameterization as a planar domain, and the metric carried
 /// onto it.
 struct Transferred {
-    domain: PlanarDomain,
+    /// The parameterization's points and triangles: the planar metric field lives on them.
+    uv: Vec<nalgebra::Point2<f64>>,
+    triangles: Vec<[u32; 3]>,
     metrics: Vec<Matrix2<f64>>,
     /// Per-triangle corner tensors ([`super::RemeshOptions::corner_pullback`]).
     corners: Option<Vec<[Matrix2<f64>; 3]>>,
@@ -341,19 +350,14 @@ impl Transferred {
             true => Some(pullback_corners(&disk.mesh, uv, metrics3d).map_err(|e| fail(e.into()))?),
             false => None,
         };
-        let domain = PlanarDomain {
-            points: uv.to_vec(),
+        Ok(Transferred {
+            uv: uv.to_vec(),
             triangles: disk
                 .mesh
                 .triangles
                 .iter()
                 .map(|t| [t[0].0, t[1].0, t[2].0])
                 .collect(),
-            boundary: disk.boundary.iter().map(|v| v.0).collect(),
-            constrained_edges: Vec::new(),
-        };
-        Ok(Transferred {
-            domain,
             metrics,
             corners,
         })
@@ -366,9 +370,8 @@ impl Transferred {
         metrics: &[Matrix2<f64>],
         base_trace: &[f64],
     ) -> Result<PlanarMetricField, StageError> {
-        let d = &self.domain;
         let field =
-            PlanarMetricField::new(d.points.clone(), d.triangles.clone(), metrics.to_vec())?;
+            PlanarMetricField::new(self.uv.clone(), self.triangles.clone(), metrics.to_vec())?;
         let Some(c) = &self.corners else {
             return Ok(field);
         };
@@ -379,7 +382,7 @@ impl Transferred {
             .collect();
         let scaled = c
             .iter()
-            .zip(&d.triangles)
+            .zip(&self.triangles)
             .map(|(c, t)| [0, 1, 2].map(|k| c[k] * factor[t[k] as usize]))
             .collect();
         Ok(field.with_corner_metrics(scaled)?)
@@ -393,6 +396,7 @@ fn remesh_and_lift(
     ctx: &RunContext<'_>,
     disk: &PatchMesh,
     transfer: &Transferred,
+    domain: &PatchDomain,
     carried: &VertexFactors,
     rng: &mut crate::Rng,
     counters: &mut Counters,
@@ -409,13 +413,14 @@ fn remesh_and_lift(
         triangles: &disk.mesh.triangles,
         positions: &disk.mesh.positions,
         to_global: &disk.to_global,
+        domain: &domain.vertices,
     };
     let base_trace: Vec<f64> = transfer.metrics.iter().map(|m| m.trace()).collect();
     let mut clock = 0.0;
     let refined = fidelity::refine(
         &setup,
         PatchVertices {
-            positions: &disk.mesh.positions,
+            positions: &domain.positions,
             to_global: &disk.to_global,
         },
         carried,
@@ -429,9 +434,9 @@ fn remesh_and_lift(
             let planar = ctx
                 .stages
                 .remesher
-                .remesh(&transfer.domain, &planar_field, ctx.plan.l_tar, rng)
+                .remesh(&domain.domain, &planar_field, ctx.plan.l_tar, rng)
                 .map_err(|e| AttemptFailure::at(Stage::PlanarRemeshing)(e.into()))?;
-            invariants::certify_planar(&transfer.domain, &planar)
+            invariants::certify_planar(&domain.domain, &planar)
                 .map_err(|e| AttemptFailure::at(Stage::PlanarRemeshing)(e.into()))?;
             match round {
                 0 => counters.cert.planar += 1,
@@ -442,7 +447,7 @@ fn remesh_and_lift(
             let replacement = lift(
                 &planar,
                 &frame,
-                |p| planar_field.locate(p),
+                |p| Some(planar_field.locate_or_nearest(p)),
                 |p| field.project(p).0,
                 field.reference(),
             )
