@@ -1,4 +1,4 @@
-//! Fidelity control (src/fidelity.rs, paper-notes "Fidelity control") end to end: on a shared
+//! Fidelity control (src/fidelity/, paper-notes "Fidelity control") end to end: on a shared
 //! mesh whose tip the curvature fit smooths away, the control brings the two-sided Hausdorff
 //! distance under 1 %, keeps every certificate, and is off with `max_deviation = 0`; a bad
 //! tolerance is refused.
