@@ -30,7 +30,7 @@ pub fn connectivity_update(ctx: &SurfaceContext<'_>, work: &mut WorkingMesh) -> 
     let mut grid = FaceGrid::new(&work.mesh);
     let mut total = 0;
     for _pass in 0..8 {
-        let flipped = flip_pass(ctx, &metrics, work, &mut grid);
+        let flipped = one_flip_pass(ctx, &metrics, work, &mut grid);
         total += flipped;
         if flipped == 0 {
             break;
@@ -75,7 +75,7 @@ impl Quad {
 
 /// One pass over the interior edges (sorted, feature lines excluded), each face flipped at
 /// most once. Returns the number of flips.
-fn flip_pass(
+fn one_flip_pass(
     ctx: &SurfaceContext<'_>,
     metrics: &[Matrix3<f64>],
     work: &mut WorkingMesh,

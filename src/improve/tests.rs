@@ -71,7 +71,7 @@ fn metric_optimal_point_recentres_an_anisotropic_fan() {
 /// The skinny pair is flipped to the short diagonal (q rises from 0.29 to 0.65) and the
 /// result is still an oriented disk over the same four vertices.
 #[test]
-fn flip_pass_flips_a_skinny_pair_on_a_flat_rhombus() {
+fn connectivity_update_flips_a_skinny_pair_on_a_flat_rhombus() {
     let (field, mut work, flip_test) = rhombus(0.0);
     let q_min = |w: &WorkingMesh| {
         crate::quality::face_qualities(&w.mesh, &[Matrix3::identity(); 4])
@@ -106,7 +106,7 @@ fn flip_pass_flips_a_skinny_pair_on_a_flat_rhombus() {
 
 /// The same skinny pair is not flipped when its diagonal is a feature-line edge.
 #[test]
-fn flip_pass_never_flips_a_feature_edge() {
+fn connectivity_update_never_flips_a_feature_edge() {
     let (field, mut work, flip_test) = rhombus(0.0);
     let before = work.mesh.triangles.clone();
     let feature: HashSet<EdgeKey> = [EdgeKey::new(VertexId(0), VertexId(1))].into();
@@ -119,7 +119,7 @@ fn flip_pass_never_flips_a_feature_edge() {
 
 /// On a ridge the flip would cut the surface by the ridge height (0.05 > tol 0.01): kept.
 #[test]
-fn flip_pass_keeps_a_ridge_beyond_the_tolerance() {
+fn connectivity_update_keeps_a_ridge_beyond_the_tolerance() {
     let (field, mut work, flip_test) = rhombus(0.05);
     let before = work.mesh.triangles.clone();
     assert_eq!(
@@ -152,7 +152,7 @@ fn hexagon(apex: Point3<f64>) -> TriMesh {
 }
 
 #[test]
-fn smooth_pass_centres_a_fan_and_keeps_a_tip() {
+fn vertex_position_update_centres_a_fan_and_keeps_a_tip() {
     let q_min = |m: &TriMesh| {
         crate::quality::face_qualities(m, &vec![Matrix3::identity(); m.n_vertices()])
             .iter()

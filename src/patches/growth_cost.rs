@@ -22,9 +22,8 @@ pub struct ConeOptions {
     /// Default 0.1 (paper).
     pub c_max: f64,
     /// Rings of processed faces added after growth (Sec. 4.2, "Expansion of cone patches"),
-    /// so consecutive patches overlap. Default 2 (the paper uses 1-2): with 1 ring the seams
-    /// between patches keep more of the input's triangles (measured end to end on 12 shared
-    /// meshes: q_avg 0.83-0.86 with 1 ring, 0.86-0.89 with 2; paper-notes.md, Algorithm 1).
+    /// so consecutive patches overlap. Default 2 (the paper uses 1-2; with 1 the seams keep
+    /// more of the input's triangles: paper-notes.md, Algorithm 1).
     pub expand_rings: usize,
     /// Refit rounds: after growth stops, refit the cone (Eq. 2) to the whole grown patch and
     /// grow again, this many times (stopping early when a round adds nothing). The paper

@@ -4,7 +4,7 @@
 use super::context::{LoopState, RunContext};
 use super::error::PipelineError;
 use super::records::{RemeshReport, RemeshResult, Warning};
-use super::replace::certify_input_boundary;
+use super::replace::certify_boundary;
 use crate::ids::{EdgeKey, PatchId, VertexId};
 use crate::improve::{finishing_passes, PassCounts, SurfaceContext};
 use crate::invariants::{self, FacePair, InvariantError, Offenders, TopologySignature};
@@ -64,7 +64,7 @@ pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(),
     ctx.signature
         .certify_same(&TopologySignature::of(topo))
         .map_err(fail)?;
-    certify_input_boundary(ctx, state).map_err(fail)?;
+    certify_boundary(ctx, state).map_err(fail)?;
     certify_corners(ctx, state)?;
     certify_features(state)?;
     state.counters.times.certify += t0.elapsed().as_secs_f64();

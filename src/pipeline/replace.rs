@@ -137,14 +137,14 @@ fn certify_after_patch(
         .certify_same(&TopologySignature::of(topo))
         .map_err(fail)?;
     cert.same_topology += 1;
-    certify_input_boundary(ctx, state).map_err(fail)?;
+    certify_boundary(ctx, state).map_err(fail)?;
     state.counters.cert.boundary_preserved += 1;
     state.counters.times.certify += t0.elapsed().as_secs_f64();
     Ok(())
 }
 
 /// The input's boundary edges and vertices are still those of the working mesh, bit for bit.
-pub fn certify_input_boundary(
+pub fn certify_boundary(
     ctx: &RunContext<'_>,
     state: &LoopState,
 ) -> Result<(), InvariantError> {

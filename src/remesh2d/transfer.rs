@@ -17,7 +17,7 @@
 
 use super::Remesh2dError;
 use crate::mesh::TriMesh;
-use nalgebra::{Matrix2, Matrix3, Point2, SymmetricEigen, Vector2, Vector3};
+use nalgebra::{Matrix2, Matrix3, Point2, SymmetricEigen, Vector2};
 
 /// Relative eigenvalue floor of transferred metrics: every eigenvalue is raised to at least
 /// `EIGEN_FLOOR_REL · λ_max` (caps the anisotropy ratio of lengths at 10⁴).
@@ -171,17 +171,7 @@ fn pullback(
         .collect())
 }
 
-/// An orthonormal basis of the plane orthogonal to the unit vector `n`.
-fn tangent_frame(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    let helper = if n.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let t1 = n.cross(&helper).normalize();
-    let t2 = n.cross(&t1);
-    (t1, t2)
-}
+
 
 /// Eq. 4: fit the in-plane rotation of the principal frame from the 1-ring, then `D K Dᵀ`.
 fn principal_fit(
@@ -209,7 +199,7 @@ fn principal_fit(
             // The metric restricted to the tangent plane: its eigenvectors are the principal
             // directions d1, d2 of the paper and its eigenvalues k1, k2 (the third principal
             // direction of a surface metric is the normal, which the plane does not see).
-            let (t1, t2) = tangent_frame(&nrm);
+            let (t1, t2) = crate::metric::tangent_frame(&nrm);
             let tm = nalgebra::Matrix3x2::from_columns(&[t1, t2]);
             let m_t = tm.transpose() * metrics3d[v] * tm;
             let eig = SymmetricEigen::new((m_t + m_t.transpose()) * 0.5);
