@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release --example library -- [MESH] [OUT.obj]` (a generated torus and
 //! `library-out.obj` by default). Choose other stages by registry name, e.g.
-//! `Stages::from_registry(("kring", Params::default()), ("sd", ..), ("lct", ..))`.
+//! `Stages::from_registry(("kring", Params::default()), ("sd", ..), ("lct", ..), false)`.
 
 use conemesh::pipeline::{RemeshOptions, Remesher};
 use conemesh::quality::{evaluate, EvalOptions, EvalReport};

@@ -202,14 +202,27 @@ impl BoundaryCurves {
 
     /// The vertices of loop `l` whose arc length lies strictly between `a` and `b` (`a ≤ b`,
     /// both possibly beyond the loop's length: taken around the loop).
-    pub fn vertices_between(&self, l: usize, a: f64, b: f64) -> impl Iterator<Item = VertexId> + '_ {
+    pub fn vertices_between(
+        &self,
+        l: usize,
+        a: f64,
+        b: f64,
+    ) -> impl Iterator<Item = VertexId> + '_ {
         let arc = &self.arc[l];
         let lp = &self.loops[l];
         let total = *arc.last().unwrap_or(&0.0);
         let m = lp.len();
         // Whole turns of the loop the interval may cover, each vertex at arc[i] + k·total.
-        let turns = if total > 0.0 { (b / total).floor() as i64 + 1 } else { 0 };
-        let first = if total > 0.0 { (a / total).floor() as i64 } else { 0 };
+        let turns = if total > 0.0 {
+            (b / total).floor() as i64 + 1
+        } else {
+            0
+        };
+        let first = if total > 0.0 {
+            (a / total).floor() as i64
+        } else {
+            0
+        };
         (first..turns.max(first))
             .flat_map(move |k| (0..m).map(move |i| (k, i)))
             .filter(move |&(k, i)| {
@@ -224,7 +237,11 @@ impl BoundaryCurves {
         let a = &self.arc[l];
         let total = *a.last().unwrap_or(&0.0);
         let m = self.loops[l].len();
-        let s = if total > 0.0 { s.rem_euclid(total) } else { 0.0 };
+        let s = if total > 0.0 {
+            s.rem_euclid(total)
+        } else {
+            0.0
+        };
         // The last edge whose start is at or before s.
         let i = a[..m].partition_point(|&x| x <= s).saturating_sub(1);
         let len = a[i + 1] - a[i];
@@ -243,7 +260,12 @@ impl BoundaryCurves {
 }
 
 /// The face of the boundary half-edge `a → b` and the index of `a` in it.
-fn boundary_face(reference: &TriMesh, topo: &Topology, a: VertexId, b: VertexId) -> (FaceId, usize) {
+fn boundary_face(
+    reference: &TriMesh,
+    topo: &Topology,
+    a: VertexId,
+    b: VertexId,
+) -> (FaceId, usize) {
     topo.vertex_faces(a)
         .iter()
         .find_map(|&f| {
@@ -269,13 +291,16 @@ pub struct CurveDistance {
 /// [`CurveDistance`] between the boundary edges of two meshes, by sampling each edge at 8
 /// points and measuring to the nearest edge of the other side (brute force over edges
 /// within a grid cell; boundaries are short).
-pub fn curve_distance(input: &TriMesh, input_topo: &Topology, output: &TriMesh, output_topo: &Topology) -> CurveDistance {
+pub fn curve_distance(
+    input: &TriMesh,
+    input_topo: &Topology,
+    output: &TriMesh,
+    output_topo: &Topology,
+) -> CurveDistance {
     let segs = |m: &TriMesh, t: &Topology| -> Vec<(Point3<f64>, Point3<f64>)> {
         t.boundary_loops()
             .iter()
-            .flat_map(|l| {
-                (0..l.len()).map(move |i| (l[i], l[(i + 1) % l.len()]))
-            })
+            .flat_map(|l| (0..l.len()).map(move |i| (l[i], l[(i + 1) % l.len()])))
             .map(|(a, b)| (m.positions[a.idx()], m.positions[b.idx()]))
             .collect()
     };
@@ -289,7 +314,11 @@ pub fn curve_distance(input: &TriMesh, input_topo: &Topology, output: &TriMesh, 
 fn point_segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     let e = b - a;
     let l2 = e.norm_squared();
-    let t = if l2 > 0.0 { ((p - a).dot(&e) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&e) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     (p - (a + e * t)).norm()
 }
 
@@ -385,11 +414,17 @@ mod tests {
     fn curve_distance_sees_a_cut_corner() {
         let m = plate();
         let topo = Topology::build(&m);
-        assert_eq!(curve_distance(&m, &topo, &m, &topo), CurveDistance::default());
+        assert_eq!(
+            curve_distance(&m, &topo, &m, &topo),
+            CurveDistance::default()
+        );
         // Move the corner (0,0) in along the diagonal: the input corner is 0.1·√2 away.
         let mut cut = m.clone();
         cut.positions[0] = Point3::new(0.1, 0.1, 0.0);
         let d = curve_distance(&m, &topo, &cut, &Topology::build(&cut));
-        assert!(d.input_to_output > 0.05 && d.output_to_input > 0.05, "{d:?}");
+        assert!(
+            d.input_to_output > 0.05 && d.output_to_input > 0.05,
+            "{d:?}"
+        );
     }
 }

@@ -90,11 +90,14 @@ pub fn lift(
         match planar.origin.get(i).copied().flatten() {
             Some(o) => match frame.domain.get(o as usize) {
                 Some(DomainVertex::Patch(l)) => {
-                    let g = frame.to_global.get(*l as usize).ok_or(LiftError::BadOrigin {
-                        index: i,
-                        origin: o,
-                        n: n_local,
-                    })?;
+                    let g = frame
+                        .to_global
+                        .get(*l as usize)
+                        .ok_or(LiftError::BadOrigin {
+                            index: i,
+                            origin: o,
+                            n: n_local,
+                        })?;
                     map.push(PatchVertex::Existing(*g));
                 }
                 Some(DomainVertex::Curve {

@@ -108,6 +108,11 @@ impl Params {
         self.given.insert(key.to_string(), value.to_string());
     }
 
+    /// True when option `key` is given.
+    pub fn contains(&self, key: &str) -> bool {
+        self.given.contains_key(key)
+    }
+
     /// True when no option is left.
     pub fn is_empty(&self) -> bool {
         self.given.is_empty()

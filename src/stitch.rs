@@ -7,8 +7,8 @@
 //! stay in the arrays until [`WorkingMesh::compact`] at the end, so ids of untouched
 //! elements are stable while the loop runs.
 
-use crate::ids::{FaceId, VertexId};
 use crate::boundary::CurvePoint;
+use crate::ids::{FaceId, VertexId};
 use crate::mesh::{SurfaceLocation, TriMesh};
 use nalgebra::Point3;
 use thiserror::Error;

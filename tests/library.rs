@@ -104,13 +104,20 @@ fn a_user_metric_through_the_library() {
     let out = remesher
         .run_with_metric(&disk, &metric)
         .expect("remeshes in the user metric");
-    assert_eq!(out.input.n_vertices(), n - 2, "unreferenced vertices dropped");
+    assert_eq!(
+        out.input.n_vertices(),
+        n - 2,
+        "unreferenced vertices dropped"
+    );
     assert_eq!(out.input_metric.as_ref().map(Vec::len), Some(n - 2));
     certify_boundary_preserved(&out.input, &out.mesh).expect("boundary kept");
     // Edges near 0.3 in file units: about (area / (0.433·0.09)) faces.
     let expected = std::f64::consts::PI * 9.0 / (3f64.sqrt() / 4.0 * 0.09);
     let f = out.mesh.n_faces() as f64;
-    assert!(f > 0.7 * expected && f < 2.5 * expected, "{f} faces, {expected:.0} expected");
+    assert!(
+        f > 0.7 * expected && f < 2.5 * expected,
+        "{f} faces, {expected:.0} expected"
+    );
     match remesher.run_with_metric(&disk, &metric[1..]) {
         Err(PipelineError::Input(msg)) => assert!(msg.contains("tensors"), "{msg}"),
         other => panic!("a short metric must be refused: {:?}", other.map(|_| ())),
@@ -155,7 +162,10 @@ fn failed_attempts_are_typed_records_and_strict_runs_keep_the_source() {
     assert!(!r.fallbacks.failures.is_empty());
     for f in &r.fallbacks.failures {
         assert_eq!(f.stage, Stage::Parameterization);
-        assert!(matches!(f.error, StageError::Param(ParamError::Solver(_))), "{f}");
+        assert!(
+            matches!(f.error, StageError::Param(ParamError::Solver(_))),
+            "{f}"
+        );
     }
     assert_eq!(r.fallbacks.kept_faces, input.n_faces());
     assert!(out.warnings.iter().any(|w| matches!(
@@ -163,7 +173,10 @@ fn failed_attempts_are_typed_records_and_strict_runs_keep_the_source() {
         Warning::FailedAttempts { kept_faces, .. } if *kept_faces == input.n_faces()
     )));
     let json = serde_json::to_value(r).expect("serialises");
-    assert_eq!(json["fallbacks"]["failures"][0]["stage"], "parameterization");
+    assert_eq!(
+        json["fallbacks"]["failures"][0]["stage"],
+        "parameterization"
+    );
     // Strict: the first failure is the error, with the stage's error as its source.
     let strict = Remesher::new(RemeshOptions {
         strict: true,
@@ -179,7 +192,10 @@ fn failed_attempts_are_typed_records_and_strict_runs_keep_the_source() {
             assert_eq!(*stage, Stage::Parameterization);
             assert!(seed.is_some());
             let source = std::error::Error::source(&e).expect("a source");
-            assert!(source.to_string().contains("refused on purpose"), "{source}");
+            assert!(
+                source.to_string().contains("refused on purpose"),
+                "{source}"
+            );
         }
         other => panic!("strict run: {:?}", other.map(|_| ())),
     }
@@ -211,8 +227,11 @@ fn running_out_of_the_patch_budget_is_an_ok_with_a_warning() {
 fn the_cli_reaches_every_registry() {
     let dir = tempfile::tempdir().expect("temp dir");
     let path = |n: &str| dir.path().join(n).to_str().expect("utf-8").to_string();
-    conemesh::io::write_mesh(Path::new(&path("in.obj")), &generators::torus(1.0, 0.4, 20, 9))
-        .expect("write");
+    conemesh::io::write_mesh(
+        Path::new(&path("in.obj")),
+        &generators::torus(1.0, 0.4, 20, 9),
+    )
+    .expect("write");
     let ok = conemesh(&[
         "remesh",
         &path("in.obj"),
@@ -232,19 +251,37 @@ fn the_cli_reaches_every_registry() {
         &path("kring.json"),
         "--quiet",
     ]);
-    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
     let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(path("kring.json")).expect("report"))
-            .expect("json");
-    assert_eq!(report["run"]["stages"], serde_json::json!(["kring", "tutte", "lct"]));
+        serde_json::from_slice(&std::fs::read(path("kring.json")).expect("report")).expect("json");
+    assert_eq!(
+        report["run"]["stages"],
+        serde_json::json!(["kring", "tutte", "lct"])
+    );
     for (args, says) in [
-        (vec!["--strategy", "spiral"], "unknown patch strategy `spiral` (known: cone, kring)"),
+        (
+            vec!["--strategy", "spiral"],
+            "unknown patch strategy `spiral` (known: cone, kring)",
+        ),
         (vec!["--param", "magic"], "unknown parameterizer `magic`"),
         (vec!["--remesher", "cvt"], "unknown planar remesher `cvt`"),
-        (vec!["--strategy-opt", "colour=red"], "has no option `colour`"),
-        (vec!["--remesher-opt", "rounds=-3"], "`-3` is not a number of rounds"),
+        (
+            vec!["--strategy-opt", "colour=red"],
+            "has no option `colour`",
+        ),
+        (
+            vec!["--remesher-opt", "rounds=-3"],
+            "`-3` is not a number of rounds",
+        ),
         (vec!["--param-opt", "weights"], "not of the form KEY=VALUE"),
-        (vec!["--strategy", "kring", "--expand-rings", "x"], "invalid value"),
+        (
+            vec!["--strategy", "kring", "--expand-rings", "x"],
+            "invalid value",
+        ),
     ] {
         let (inp, out) = (path("in.obj"), path("refused.obj"));
         let mut a = vec!["remesh", &inp, "-o", &out, "--quiet"];
@@ -257,7 +294,19 @@ fn the_cli_reaches_every_registry() {
     }
     let stages = conemesh(&["stages"]);
     let text = String::from_utf8_lossy(&stages.stdout);
-    for name in ["cone", "kring", "sd", "tutte", "lct", "expand_rings", "weights", "rounds"] {
-        assert!(text.contains(name), "`conemesh stages` lists {name}:\n{text}");
+    for name in [
+        "cone",
+        "kring",
+        "sd",
+        "tutte",
+        "lct",
+        "expand_rings",
+        "weights",
+        "rounds",
+    ] {
+        assert!(
+            text.contains(name),
+            "`conemesh stages` lists {name}:\n{text}"
+        );
     }
 }

@@ -6,7 +6,7 @@
 //!
 //! One `#[test]` per mesh so that they run in parallel; release only.
 
-use conemesh::invariants::{certify_boundary_preserved, certify_same_topology, self_intersections};
+use conemesh::invariants::{certify_boundary_on_curves, certify_same_topology, self_intersections};
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
 use conemesh::pipeline::{remesh, RemeshOptions, RemeshReport, Stages};
 use conemesh::quality::{evaluate, flips, EvalOptions, EvalReport};
@@ -100,8 +100,14 @@ fn remesh_shared(name: &str, boundary_loops: usize) -> (RemeshReport, EvalReport
     assert!(out_topo.is_oriented_manifold(), "{name}: oriented manifold");
     certify_same_topology(reference, &result.mesh)
         .unwrap_or_else(|e| panic!("{name}: topology changed: {e}"));
-    certify_boundary_preserved(reference, &result.mesh)
-        .unwrap_or_else(|e| panic!("{name}: boundary not preserved: {e}"));
+    certify_boundary_on_curves(
+        &result.curves,
+        reference,
+        &result.mesh,
+        &out_topo,
+        &result.curve,
+    )
+    .unwrap_or_else(|e| panic!("{name}: boundary not on the input's curves: {e}"));
     assert_eq!(out_topo.boundary_loops().len(), boundary_loops, "{name}");
     let flipped = flips(reference, &result.mesh);
     assert!(

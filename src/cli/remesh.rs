@@ -108,6 +108,26 @@ pub struct RemeshArgs {
     /// the report says whether it ran), `on` always, `off` never.
     #[arg(long, value_enum, default_value_t = Coarse::Auto)]
     pub coarse: Coarse,
+    /// Smallest edge size, in the mesh's units: the metric's sizes are clamped below (MMG's
+    /// `-hmin`). Default: none.
+    #[arg(long)]
+    pub hmin: Option<f64>,
+    /// Largest edge size, in the mesh's units (MMG's `-hmax`). Default: none.
+    #[arg(long)]
+    pub hmax: Option<f64>,
+    /// Metric gradation β > 1: sizes grow by at most a factor (1 + ℓ·ln β) over an edge of
+    /// metric length ℓ, keeping each tensor's directions (MMG's `-hgrad`, whose default is
+    /// 1.3). Default: off.
+    #[arg(long)]
+    pub hgrad: Option<f64>,
+    /// Keep the input's boundary vertices and edges as they are instead of resampling the
+    /// boundary curves to the metric.
+    #[arg(long)]
+    pub keep_boundary: bool,
+    /// Boundary vertices where the boundary turns by at least this many degrees are corners
+    /// and stay.
+    #[arg(long, default_value_t = conemesh::boundary::BoundaryOptions::default().corner_angle)]
+    pub boundary_corner_angle: f64,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -141,7 +161,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         ),
         None => None,
     };
-    let remesher = Remesher::new(options(&args)).with_stages(stages(&args)?);
+    let remesher = Remesher::new(options(&args)).with_stages(stages(&args, metric.is_some())?);
     let bar = progress_bar(args.quiet, mesh.n_faces() as u64);
     let result = remesher.run_with(&mesh, metric.as_deref(), |p: Progress| {
         bar.set_length(p.total as u64);
@@ -256,6 +276,15 @@ fn options(args: &RemeshArgs) -> RemeshOptions {
         sweeps: args.sweeps,
         corner_defect: (args.corner_defect != 0.0).then_some(args.corner_defect),
         feature_angle: (args.feature_angle != 0.0).then_some(args.feature_angle),
+        sizes: conemesh::metric::SizeOptions {
+            hmin: args.hmin,
+            hmax: args.hmax,
+            hgrad: args.hgrad,
+        },
+        boundary: conemesh::boundary::BoundaryOptions {
+            resample: !args.keep_boundary,
+            corner_angle: args.boundary_corner_angle,
+        },
         coarse_input: match args.coarse {
             Coarse::Auto => CoarseInput::Auto,
             Coarse::On => CoarseInput::On,
@@ -265,8 +294,9 @@ fn options(args: &RemeshArgs) -> RemeshOptions {
     }
 }
 
-/// The three extension points by registry name, with their options.
-fn stages(args: &RemeshArgs) -> anyhow::Result<Stages> {
+/// The three extension points by registry name, with their options. With a user metric the
+/// planar remesher's `sizes` option defaults to true (absolute sizes), as in the library.
+fn stages(args: &RemeshArgs, user_metric: bool) -> anyhow::Result<Stages> {
     let mut strategy = Params::parse(&args.strategy_opt)?;
     if let Some(r) = args.expand_rings {
         strategy.set("expand_rings", r);
@@ -278,6 +308,7 @@ fn stages(args: &RemeshArgs) -> anyhow::Result<Stages> {
         (&args.strategy, strategy),
         (&args.param, Params::parse(&args.param_opt)?),
         (&args.remesher, Params::parse(&args.remesher_opt)?),
+        user_metric,
     )?)
 }
 

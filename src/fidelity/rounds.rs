@@ -131,6 +131,10 @@ pub struct RoundsSetup<'a> {
 
 /// One round's planar remesh, the planar metric field it was made in, and its lift.
 pub struct RoundOutput {
+    /// The 3D position of every planar vertex (in the planar mesh's order).
+    pub lifted: Vec<Point3<f64>>,
+    /// The plane position of every new vertex of the replacement (in its order).
+    pub new_uv: Vec<nalgebra::Point2<f64>>,
     /// The certified planar remesh.
     pub planar: PlanarMesh,
     /// The planar metric field (on the initial 2D mesh) of this round.
@@ -149,11 +153,10 @@ pub struct Refined {
     pub factors: PatchFactors,
 }
 
-/// The vertices of a patch's initial 2D mesh: 3D positions and working-mesh ids.
+/// The vertices of a patch's initial 2D mesh (the parameterization's): their working-mesh
+/// ids.
 #[derive(Copy, Clone)]
 pub struct PatchVertices<'a> {
-    /// 3D position of each.
-    pub positions: &'a [Point3<f64>],
     /// Working-mesh id of each.
     pub to_global: &'a [VertexId],
 }
@@ -174,20 +177,14 @@ pub fn refine<E>(
     mut round: impl FnMut(&[Matrix2<f64>], usize) -> Result<RoundOutput, E>,
 ) -> Result<Refined, E> {
     let o = setup.options;
-    let PatchVertices {
-        positions,
-        to_global,
-    } = vertices;
+    let PatchVertices { to_global } = vertices;
     let base_trace: Vec<f64> = metrics.iter().map(|m| m.trace()).collect();
     let mut rounds = 0usize;
     loop {
         let out = round(&metrics, rounds)?;
         let eps = o.max_deviation;
         let finish = |out: RoundOutput, metrics: &[Matrix2<f64>]| {
-            let factors = match o.persist {
-                true => factors_after(&out, metrics, &base_trace, carried, to_global),
-                false => PatchFactors::default(),
-            };
+            let factors = factors_after(&out, metrics, &base_trace, carried, to_global);
             Refined {
                 replacement: out.replacement,
                 rounds,
@@ -198,26 +195,29 @@ pub fn refine<E>(
             return Ok(finish(out, &metrics));
         }
         let t0 = Instant::now();
-        let mut next_new = 0usize;
-        let lifted: Vec<Point3<f64>> = out
-            .planar
-            .origin
-            .iter()
-            .map(|origin| match origin {
-                Some(i) => positions[*i as usize],
-                None => {
-                    next_new += 1;
-                    out.replacement.new_positions[next_new - 1]
-                }
-            })
-            .collect();
         let fixed: Vec<bool> = out.planar.origin.iter().map(Option::is_some).collect();
+        let lifted = &out.lifted;
         let patch = LiftedPatch {
-            positions: &lifted,
+            positions: lifted,
             fixed: &fixed,
             triangles: &out.planar.triangles,
         };
         let deviating = deviations(setup.field, setup.normals, &patch, eps);
+        if std::env::var("DBG_FID").is_ok() {
+            let worst = deviating.iter().map(|d| d.1).fold(0.0, f64::max);
+            eprintln!(
+                "round {rounds}: {} deviating (eps {eps}), worst {worst}",
+                deviating.len()
+            );
+            for &(t, d) in deviating.iter().take(5) {
+                let tri = out.planar.triangles[t];
+                eprintln!(
+                    "  t{t} d {d} fixed {:?} pos {:?}",
+                    tri.map(|i| fixed[i as usize]),
+                    tri.map(|i| lifted[i as usize])
+                );
+            }
+        }
         let scaled = match deviating.is_empty() {
             true => 0,
             false => scale_metric(
@@ -263,12 +263,9 @@ fn factors_after(
         .collect();
     let tris = out.field.triangles();
     let new: Vec<f64> = out
-        .planar
-        .points
+        .new_uv
         .iter()
-        .zip(&out.planar.origin)
-        .filter(|(_, o)| o.is_none())
-        .map(|(p, _)| match out.field.locate(p) {
+        .map(|p| match out.field.locate(p) {
             Some((t, b)) => (0..3)
                 .map(|k| b[k] * total[tris[t][k] as usize])
                 .sum::<f64>()

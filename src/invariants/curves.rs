@@ -66,7 +66,10 @@ pub fn certify_boundary_on_curves(
             )));
         }
         if std::mem::replace(&mut seen[c as usize], true) {
-            return Err(broken(format!("two loops lie on curve {c} (one through {})", l[0])));
+            return Err(broken(format!(
+                "two loops lie on curve {c} (one through {})",
+                l[0]
+            )));
         }
         // Once around: exactly one descent in the cyclic sequence (where it passes the
         // curve's first vertex), every other step strictly forward.
@@ -143,7 +146,10 @@ mod tests {
         // A point moved along the curve (still on it) keeps the certificate.
         let mut slid = d.clone();
         let mut sl = pts.clone();
-        let p = CurvePoint { t: 0.25, ..pts[l[3].idx()].expect("on the curve") };
+        let p = CurvePoint {
+            t: 0.25,
+            ..pts[l[3].idx()].expect("on the curve")
+        };
         slid.positions[l[3].idx()] = c.position(&d, &p);
         sl[l[3].idx()] = Some(p);
         certify_boundary_on_curves(&c, &d, &slid, &t, &sl).expect("slid along the curve");
@@ -159,7 +165,10 @@ mod tests {
         let l = t.boundary_loops()[0].clone();
         let mut slid = d.clone();
         let mut sl = pts.clone();
-        let p = CurvePoint { t: 0.5, ..pts[l[0].idx()].expect("on the curve") };
+        let p = CurvePoint {
+            t: 0.5,
+            ..pts[l[0].idx()].expect("on the curve")
+        };
         slid.positions[l[0].idx()] = c.position(&d, &p);
         sl[l[0].idx()] = Some(p);
         assert!(matches!(

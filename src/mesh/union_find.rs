@@ -44,7 +44,9 @@ impl UnionFind {
 
     /// The number of sets.
     pub fn count(&mut self) -> usize {
-        (0..self.parent.len()).filter(|&i| self.find(i) == i).count()
+        (0..self.parent.len())
+            .filter(|&i| self.find(i) == i)
+            .count()
     }
 }
 

@@ -178,6 +178,36 @@ impl MetricField {
         })
     }
 
+    /// A field from a user's tensors (validated as [`MetricField::new`]), restricted to the
+    /// surface: each tensor `M` becomes `P M P` with `P = I − n nᵀ` for the vertex normal `n`,
+    /// its block on the tangent plane. A user metric (a Medit `.sol` made for MMG) is SPD in
+    /// 3D with a large eigenvalue along the normal; left in, that eigenvalue leaks into the
+    /// tangent directions of every face that is not exactly perpendicular to the vertex normal
+    /// (a cylinder with 60 sectors and sizes 0.03/0.3: +27 % on the circumferential
+    /// eigenvalue), so the triangles would follow a metric the user did not give. Vertices
+    /// without a normal keep their tensor.
+    pub fn from_surface_tensors(
+        reference: TriMesh,
+        vertex_metrics: Vec<Matrix3<f64>>,
+    ) -> Result<Self, MetricError> {
+        let field = MetricField::new(reference, vertex_metrics)?;
+        let normals = field.reference.vertex_normals();
+        let metrics = field
+            .metrics
+            .iter()
+            .zip(&normals)
+            .map(|(m, n)| match n.norm() > 0.5 {
+                true => {
+                    let p = Matrix3::identity() - n * n.transpose();
+                    let t = p * m * p;
+                    (t + t.transpose()) * 0.5
+                }
+                false => *m,
+            })
+            .collect();
+        Ok(MetricField { metrics, ..field })
+    }
+
     /// The curvature metric of Sec. 4.1 on `reference` ([`curvature_metric`]; expects the
     /// unit-space mesh), wrapped in a field.
     pub fn from_curvature(reference: TriMesh, opts: &MetricOptions) -> Result<Self, MetricError> {

@@ -11,10 +11,12 @@
 pub mod curvature;
 pub mod field;
 pub mod normalize;
+pub mod sizes;
 
 pub use curvature::{principal_curvatures, tangent_frame, CurvatureOptions, PrincipalCurvature};
 pub use field::{validate_vertex_metric, MetricField};
 pub use normalize::Normalization;
+pub use sizes::{apply_sizes, SizeOptions};
 
 use crate::mesh::{MeshError, TriMesh};
 use nalgebra::Matrix3;

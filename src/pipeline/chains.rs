@@ -140,6 +140,25 @@ pub fn patch_domain(
         .filter(|v| !on_loop.contains(v))
         .collect();
     let interior_uv: Vec<Point2<f64>> = interior.iter().map(|v| uv[v.idx()]).collect();
+    if std::env::var("DBG_CHAIN").is_ok() {
+        let old: Vec<Point2<f64>> = b.iter().map(|v| uv[v.idx()]).collect();
+        eprintln!(
+            "chains {} old loop {} new loop {}",
+            chains.len(),
+            old.len(),
+            loop_uv.len()
+        );
+        let f = format!("/tmp/chain-{}.txt", loop_uv.len());
+        let mut txt = String::new();
+        for (q, p) in loop_uv.iter().zip(&loop_pos) {
+            txt += &format!("N {} {} {} {} {}\n", q.x, q.y, p.x, p.y, p.z);
+        }
+        for (v, q) in b.iter().zip(&old) {
+            let p = disk.mesh.positions[v.idx()];
+            txt += &format!("O {} {} {} {} {}\n", q.x, q.y, p.x, p.y, p.z);
+        }
+        let _ = std::fs::write(f, txt);
+    }
     let Ok((domain, kept)) = triangulate_polygon_with(&loop_uv, &interior_uv) else {
         return unchanged();
     };
@@ -262,7 +281,11 @@ impl Sampler<'_> {
         let mut arc = vec![self.curves.arc(&chain[0].0)];
         for w in chain.windows(2) {
             let d = (self.curves.arc(&w[1].0) - self.curves.arc(&w[0].0)).rem_euclid(total_arc);
-            let d = if d == 0.0 && w[1].0 == chain[0].0 { total_arc } else { d };
+            let d = if d == 0.0 && w[1].0 == chain[0].0 {
+                total_arc
+            } else {
+                d
+            };
             arc.push(arc.last().copied().unwrap_or(0.0) + d);
         }
         // Cumulative metric length over SAMPLES sub-segments of every chain edge.
@@ -272,7 +295,9 @@ impl Sampler<'_> {
             for k in 0..SAMPLES {
                 let (t0, t1) = (k as f64 / SAMPLES as f64, (k + 1) as f64 / SAMPLES as f64);
                 let (p, q) = (a + (b - a) * t0, b + (a - b) * (1.0 - t1));
-                let m = self.metric.metric(&Point2::from((p.coords + q.coords) * 0.5));
+                let m = self
+                    .metric
+                    .metric(&Point2::from((p.coords + q.coords) * 0.5));
                 let e = q - p;
                 let l = e.dot(&(m * e)).max(0.0).sqrt();
                 cum.push(cum.last().copied().unwrap_or(0.0) + l);
@@ -290,7 +315,10 @@ impl Sampler<'_> {
             let (c0, c1) = (cum[k - 1], cum[k]);
             let f = if c1 > c0 { (s - c0) / (c1 - c0) } else { 0.5 };
             let sub = (k - 1) as f64 + f;
-            let (e, t) = ((sub / SAMPLES as f64).floor() as usize, sub / SAMPLES as f64);
+            let (e, t) = (
+                (sub / SAMPLES as f64).floor() as usize,
+                sub / SAMPLES as f64,
+            );
             let e = e.min(chain.len() - 2);
             let t = (t - e as f64).clamp(0.0, 1.0);
             arc[e] + (arc[e + 1] - arc[e]) * t
@@ -334,8 +362,10 @@ impl Sampler<'_> {
     /// to the chord between the curve points there.
     fn chord_error(&self, curve: usize, a: f64, b: f64) -> f64 {
         let (pa, pb) = (
-            self.curves.position(self.reference, &self.curves.at_arc(curve, a)),
-            self.curves.position(self.reference, &self.curves.at_arc(curve, b)),
+            self.curves
+                .position(self.reference, &self.curves.at_arc(curve, a)),
+            self.curves
+                .position(self.reference, &self.curves.at_arc(curve, b)),
         );
         let e = pb - pa;
         let l2 = e.norm_squared();
@@ -343,7 +373,11 @@ impl Sampler<'_> {
             .vertices_between(curve, a, b)
             .map(|v| {
                 let p = self.reference.positions[v.idx()];
-                let t = if l2 > 0.0 { ((p - pa).dot(&e) / l2).clamp(0.0, 1.0) } else { 0.0 };
+                let t = if l2 > 0.0 {
+                    ((p - pa).dot(&e) / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
                 (p - (pa + e * t)).norm()
             })
             .fold(0.0, f64::max)
@@ -354,7 +388,11 @@ impl Sampler<'_> {
 fn uv_at(chain: &[(CurvePoint, Point2<f64>)], arc: &[f64], s: f64) -> Point2<f64> {
     let k = arc.partition_point(|&x| x <= s).clamp(1, arc.len() - 1);
     let (a0, a1) = (arc[k - 1], arc[k]);
-    let t = if a1 > a0 { ((s - a0) / (a1 - a0)).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if a1 > a0 {
+        ((s - a0) / (a1 - a0)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let (p, q) = (chain[k - 1].1, chain[k].1);
     p + (q - p) * t
 }

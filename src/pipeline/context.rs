@@ -101,6 +101,19 @@ impl<'a> RunContext<'a> {
     }
 }
 
+/// The a-priori fidelity factor at a point of the reference (1 when the control is off).
+pub fn a_priori_at(
+    fid_scale: &[f64],
+    reference: &crate::mesh::TriMesh,
+    loc: &crate::mesh::SurfaceLocation,
+) -> f64 {
+    if fid_scale.is_empty() {
+        return 1.0;
+    }
+    let t = reference.face(loc.face);
+    (0..3).map(|k| loc.bary[k] * fid_scale[t[k].idx()]).sum()
+}
+
 /// The working mesh and everything kept in step with it while the loop runs.
 pub struct LoopState {
     /// The mesh being remeshed, its vertices' reference locations and processed flags.
@@ -111,8 +124,13 @@ pub struct LoopState {
     pub features: FeatureLines,
     /// `pinned[v]`: corners and feature-line vertices, which no pass moves.
     pub pinned: Vec<bool>,
-    /// The fidelity factor per working-mesh vertex.
+    /// The fidelity factor per working-mesh vertex (carried between patches with
+    /// [`crate::fidelity::FidelityOptions::persist`]).
     pub factors: VertexFactors,
+    /// By how much the fidelity control scaled the metric where each working-mesh vertex was
+    /// made (the a-priori factor at its location times its patch's rounds): above 1 the
+    /// tolerance, not the metric, set the size there.
+    pub bound: Vec<f64>,
     /// Which patch produced each working-mesh face (`None`: an input face).
     pub face_patch: Vec<Option<PatchId>>,
     /// Faces of the working mesh when the loop started (one sweep's work).
@@ -167,7 +185,13 @@ impl LoopState {
             true => ctx.reference_topology.clone(),
             false => Topology::build(&work.mesh),
         };
+        let bound = work
+            .locations
+            .iter()
+            .map(|l| a_priori_at(&ctx.plan.fid_scale, reference, l))
+            .collect();
         Ok(LoopState {
+            bound,
             factors: VertexFactors::ones(work.mesh.n_vertices()),
             face_patch: vec![None; work.mesh.n_faces()],
             faces_per_sweep: work.mesh.n_faces(),

@@ -3,7 +3,7 @@
 
 use super::context::{LoopState, RunContext};
 use super::error::PipelineError;
-use super::records::{RemeshReport, RemeshResult, Warning};
+use super::records::{FaceSummary, RemeshReport, RemeshResult, SeamQuality, Sizes, Warning};
 use super::replace::certify_boundary;
 use crate::ids::{EdgeKey, PatchId, VertexId};
 use crate::improve::{finishing_passes, PassCounts, SurfaceContext};
@@ -68,7 +68,14 @@ pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(),
     certify_corners(ctx, state)?;
     certify_features(state)?;
     state.counters.times.certify += t0.elapsed().as_secs_f64();
-    state.work.compact();
+    let map = state.work.compact();
+    let mut bound = vec![1.0; state.work.mesh.n_vertices()];
+    for (old, new) in map.iter().enumerate() {
+        if let Some(n) = new {
+            bound[n.idx()] = state.bound.get(old).copied().unwrap_or(1.0);
+        }
+    }
+    state.bound = bound;
     let t0 = Instant::now();
     if ctx.plan.options.check_self_intersections {
         let pairs = invariants::self_intersections(&state.work.mesh);
@@ -129,6 +136,83 @@ fn certify_features(state: &LoopState) -> Result<(), PipelineError> {
     }
 }
 
+/// The faces touching a seam (an edge whose two faces came from different patches, or from a
+/// patch and the input) against the rest, in the unscaled metric.
+fn seam_quality(
+    ctx: &RunContext<'_>,
+    work: &crate::stitch::WorkingMesh,
+    face_patch: &[Option<PatchId>],
+) -> SeamQuality {
+    use crate::quality::{face_metric, triangle_quality};
+    let mesh = &work.mesh;
+    let topo = Topology::build(mesh);
+    let metrics: Vec<nalgebra::Matrix3<f64>> = work
+        .locations
+        .iter()
+        .map(|l| ctx.quality_field.eval_at(l))
+        .collect();
+    let mut seam = vec![false; mesh.n_faces()];
+    for f in mesh.faces() {
+        for i in 0..3 {
+            if let Some(g) = topo.neighbor(f, i) {
+                if face_patch.get(f.idx()) != face_patch.get(g.idx()) {
+                    seam[f.idx()] = true;
+                }
+            }
+        }
+    }
+    let summary = |on: bool| {
+        let qs: Vec<_> = mesh
+            .faces()
+            .filter(|f| seam[f.idx()] == on)
+            .map(|f| triangle_quality(mesh.face_points(f), &face_metric(&metrics, mesh.face(f))))
+            .collect();
+        let n = qs.len();
+        let nf = n.max(1) as f64;
+        FaceSummary {
+            faces: n,
+            q_min: qs
+                .iter()
+                .map(|q| q.q)
+                .fold(f64::INFINITY, f64::min)
+                .min(1.0),
+            q_avg: qs.iter().map(|q| q.q).sum::<f64>() / nf,
+            theta_min: qs.iter().map(|q| q.min_angle()).fold(180.0, f64::min),
+            theta_avg: qs.iter().map(|q| q.min_angle()).sum::<f64>() / nf,
+        }
+    };
+    SeamQuality {
+        seam: summary(true),
+        rest: summary(false),
+    }
+}
+
+/// Edge lengths against L_tar in the unscaled metric: all edges, and those whose endpoints
+/// were not made in a metric the fidelity control scaled up.
+fn sizes_on_target(ctx: &RunContext<'_>, state: &LoopState) -> Sizes {
+    use crate::quality::edge_conformity_where;
+    let mesh = &state.work.mesh;
+    let metrics: Vec<nalgebra::Matrix3<f64>> = state
+        .work
+        .locations
+        .iter()
+        .map(|l| ctx.quality_field.eval_at(l))
+        .collect();
+    let free = |v: VertexId| state.bound.get(v.idx()).copied().unwrap_or(1.0) <= 1.0 + 1e-9;
+    let l = ctx.plan.l_tar;
+    let all = edge_conformity_where(mesh, &metrics, l, |_| true);
+    let unbound = edge_conformity_where(mesh, &metrics, l, |e| free(e.0) && free(e.1));
+    Sizes {
+        bound_edges: all.edges - unbound.edges,
+        bound_vertices: (0..mesh.n_vertices())
+            .filter(|&v| !free(VertexId::new(v)))
+            .count(),
+        faces_added_by_fidelity: (ctx.plan.expected_fidelity - ctx.plan.expected).max(0.0),
+        all,
+        unbound,
+    }
+}
+
 /// The result of the run: the compacted mesh, its locations and provenance, and the report.
 pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -> RemeshResult {
     let plan = ctx.plan;
@@ -160,7 +244,19 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -
             output_pairs: cert.self_intersecting_pairs,
         });
     }
+    let seams = seam_quality(ctx, &state.work, &state.face_patch);
+    let sizes = sizes_on_target(ctx, &state);
+    let out_topo = Topology::build(&state.work.mesh);
+    let boundary_distance = crate::boundary::curve_distance(
+        reference,
+        &ctx.reference_topology,
+        &state.work.mesh,
+        &out_topo,
+    );
     let report = RemeshReport {
+        seams,
+        sizes,
+        boundary_distance,
         options: plan.options.clone(),
         stages: ctx.stages.names(),
         l_avg: plan.l_avg,
@@ -188,6 +284,8 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -
         mesh: state.work.mesh,
         locations: state.work.locations,
         face_patch: state.face_patch,
+        curve: state.work.curve,
+        curves: ctx.curves.clone(),
         report,
     }
 }

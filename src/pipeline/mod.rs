@@ -66,7 +66,7 @@ pub fn remesh(
 ) -> Result<RemeshResult, PipelineError> {
     let topo = certified_input_topology(field)?;
     let plan = Plan::resolve(field, &topo, options)?;
-    let ctx = RunContext::new(field, topo, &plan, stages);
+    let ctx = RunContext::new(plan.quality_field(field), topo, &plan, stages);
     let mut state = LoopState::new(&ctx)?;
     let mut rng = crate::Rng::seed_from_u64(plan.options.seed);
     while state.face_remains(&ctx) {

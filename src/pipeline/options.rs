@@ -2,6 +2,7 @@
 
 use crate::boundary::BoundaryOptions;
 use crate::fidelity::FidelityOptions;
+use crate::metric::SizeOptions;
 use crate::param::{Parameterizer, SymmetricDirichlet};
 use crate::patches::{ConePatches, PatchStrategy};
 use crate::registry::{Params, RegistryError};
@@ -63,6 +64,10 @@ pub struct RemeshOptions {
     /// edges of the output (no patch crosses them, no pass moves or flips them). `None`
     /// keeps none (the paper). Default `None`.
     pub feature_angle: Option<f64>,
+    /// Bounds and gradation of the metric's sizes ([`crate::metric::sizes`]), in the units of
+    /// the field given to [`super::remesh`] ([`super::Remesher`] takes them in file units).
+    /// All off by default.
+    pub sizes: SizeOptions,
     /// The input's boundary (ours, [`crate::boundary`]): resampled to the metric on the input's
     /// boundary curves, corners kept (default), or kept vertex for vertex.
     pub boundary: BoundaryOptions,
@@ -109,6 +114,7 @@ impl Default for RemeshOptions {
             feature_angle: None,
             coarse_input: CoarseInput::Auto,
             boundary: BoundaryOptions::default(),
+            sizes: SizeOptions::default(),
         }
     }
 }
@@ -145,6 +151,7 @@ impl RemeshOptions {
                 ));
             }
         }
+        self.sizes.validate()?;
         let b = self.boundary.corner_angle;
         if !(b.is_finite() && b > 0.0 && b <= 180.0) {
             return Err(format!(
@@ -185,12 +192,34 @@ impl Default for Stages {
 }
 
 impl Stages {
-    /// The stages of registry rows by name, each with its `KEY=VALUE` options.
+    /// The paper's stages with the planar remesher set for absolute sizes
+    /// ([`crate::remesh2d::LctOptions::for_absolute_sizes`]): the default with a user metric.
+    pub fn for_user_metric() -> Stages {
+        Stages {
+            remesher: Box::new(Lct {
+                options: crate::remesh2d::LctOptions::for_absolute_sizes(),
+            }),
+            ..Stages::default()
+        }
+    }
+
+    /// The stages of registry rows by name, each with its `KEY=VALUE` options. With a
+    /// `user_metric`, a planar remesher that has a `sizes` option gets `sizes=true` unless it
+    /// is given (absolute sizes; as [`Stages::for_user_metric`]).
     pub fn from_registry(
         strategy: (&str, Params),
         parameterizer: (&str, Params),
         remesher: (&str, Params),
+        user_metric: bool,
     ) -> Result<Stages, RegistryError> {
+        let (name, mut params) = remesher;
+        let declares_sizes = crate::remesh2d::REMESHERS
+            .iter()
+            .any(|e| e.name == name && e.options.iter().any(|o| o.name == "sizes"));
+        if user_metric && declares_sizes && !params.contains("sizes") {
+            params.set("sizes", true);
+        }
+        let remesher = (name, params);
         Ok(Stages {
             patches: crate::patches::strategy(strategy.0, strategy.1)?,
             parameterizer: crate::param::parameterizer(parameterizer.0, parameterizer.1)?,

@@ -237,6 +237,49 @@ impl fmt::Display for Warning {
     }
 }
 
+/// Quality of a set of faces in the metric (Sec. 4.1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct FaceSummary {
+    /// Faces.
+    pub faces: usize,
+    /// Smallest q.
+    pub q_min: f64,
+    /// Mean q.
+    pub q_avg: f64,
+    /// Smallest angle (degrees).
+    pub theta_min: f64,
+    /// Mean of each face's smallest angle (degrees).
+    pub theta_avg: f64,
+}
+
+/// Whether the seams between patches leave a trace: the faces touching a former patch
+/// boundary (an edge between faces of two patches, or of a patch and a kept input face)
+/// against the rest.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SeamQuality {
+    /// Faces with an edge on a seam.
+    pub seam: FaceSummary,
+    /// All other faces.
+    pub rest: FaceSummary,
+}
+
+/// Edge lengths against L_tar, and where the fidelity tolerance rather than the metric set
+/// them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Sizes {
+    /// Every edge (unit space, unscaled metric; as `conemesh eval`).
+    pub all: crate::quality::Conformity,
+    /// The edges between vertices made where the fidelity control did not scale the metric.
+    pub unbound: crate::quality::Conformity,
+    /// Edges with an endpoint where the tolerance bound.
+    pub bound_edges: usize,
+    /// Vertices made where the tolerance bound.
+    pub bound_vertices: usize,
+    /// Faces the a-priori fidelity scaling adds to the expected output
+    /// ([`RemeshReport::expected_faces_fidelity`] − [`RemeshReport::expected_faces`]).
+    pub faces_added_by_fidelity: f64,
+}
+
 /// The report of a run (serialised into `--report`).
 #[derive(Clone, Debug, Serialize)]
 pub struct RemeshReport {
@@ -287,6 +330,12 @@ pub struct RemeshReport {
     pub coarse_input: bool,
     /// Everything the user should know about this run.
     pub warnings: Vec<Warning>,
+    /// Faces along the seams between patches against the rest.
+    pub seams: SeamQuality,
+    /// Edge lengths against L_tar, and where the fidelity tolerance set them.
+    pub sizes: Sizes,
+    /// Distances between the input's boundary curves and the output's boundary (unit space).
+    pub boundary_distance: crate::boundary::CurveDistance,
 }
 
 /// The outcome of Algorithm 1 (unit-diagonal space; [`super::Remesher`] maps it back to file
@@ -300,6 +349,10 @@ pub struct RemeshResult {
     /// Which patch produced each output face (`None`: an input face no patch replaced, i.e.
     /// kept unchanged). Diagnostics: where the seams and kept faces are.
     pub face_patch: Vec<Option<PatchId>>,
+    /// Where each output vertex lies on the input's boundary curves (`None` inside).
+    pub curve: Vec<Option<crate::boundary::CurvePoint>>,
+    /// The input's boundary curves (vertex ids of the input, shared by the file-unit mesh).
+    pub curves: crate::boundary::BoundaryCurves,
     /// What was done and certified.
     pub report: RemeshReport,
 }

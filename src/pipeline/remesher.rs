@@ -15,9 +15,9 @@
 use super::error::PipelineError;
 use super::options::{RemeshOptions, Stages};
 use super::records::{Progress, RemeshResult, Warning};
-use crate::invariants;
-use crate::mesh::{SurfaceLocation, TriMesh};
 use crate::ids::VertexId;
+use crate::invariants;
+use crate::mesh::TriMesh;
 use crate::metric::{MetricError, MetricField, MetricOptions, Normalization};
 use nalgebra::Matrix3;
 
@@ -28,8 +28,9 @@ use nalgebra::Matrix3;
 pub struct Remesher {
     /// Options of Algorithm 1.
     pub options: RemeshOptions,
-    /// The extension points (the paper's methods by default).
-    pub stages: Stages,
+    /// The extension points; `None`: the paper's methods, with the planar remesher set for
+    /// absolute sizes when a user metric is given ([`Stages::for_user_metric`]).
+    pub stages: Option<Stages>,
     /// How the curvature metric is estimated (when no user metric is given).
     pub metric: MetricOptions,
 }
@@ -68,14 +69,17 @@ impl Remesher {
     pub fn new(options: RemeshOptions) -> Remesher {
         Remesher {
             options,
-            stages: Stages::default(),
+            stages: None,
             metric: MetricOptions::default(),
         }
     }
 
     /// The same with other extension points.
     pub fn with_stages(self, stages: Stages) -> Remesher {
-        Remesher { stages, ..self }
+        Remesher {
+            stages: Some(stages),
+            ..self
+        }
     }
 
     /// Remesh `input` (file units) in its curvature metric.
@@ -127,22 +131,41 @@ impl Remesher {
         let field = match &input_metric {
             Some(m) => {
                 let unit = m.iter().map(|m| norm.metric_to_unit(m)).collect();
-                MetricField::new(reference, unit).map_err(|e| in_file_numbering(e, &map))?
+                MetricField::from_surface_tensors(reference, unit)
+                    .map_err(|e| in_file_numbering(e, &map))?
             }
             None => MetricField::from_curvature(reference, &self.metric)?,
         };
-        let unit = super::remesh(&field, &self.stages, &self.options, on_progress)?;
-        let mesh = to_file_units(
-            &unit.mesh,
-            &unit.locations,
-            field.reference(),
-            &file_mesh,
-            &norm,
-        );
+        // The size controls are given in file units; the run is in unit space.
+        let mut options = self.options.clone();
+        options.sizes.hmin = options.sizes.hmin.map(|h| h * norm.scale);
+        options.sizes.hmax = options.sizes.hmax.map(|h| h * norm.scale);
+        let defaults;
+        let stages = match (&self.stages, metric.is_some()) {
+            (Some(s), _) => s,
+            (None, user) => {
+                defaults = if user {
+                    Stages::for_user_metric()
+                } else {
+                    Stages::default()
+                };
+                &defaults
+            }
+        };
+        let unit = super::remesh(&field, stages, &options, on_progress)?;
+        let mesh = to_file_units(&unit, field.reference(), &file_mesh, &norm);
         // The certificates were taken in unit space; mapping back to file units rounds the new
         // vertices, so the mesh that is returned is certified again (exact): no degenerate
         // face, and no self-intersection where the unit-space output had none.
         invariants::certify_no_degenerate_faces(&mesh).map_err(PipelineError::FileUnits)?;
+        invariants::certify_boundary_on_curves(
+            &unit.curves,
+            &file_mesh,
+            &mesh,
+            &crate::mesh::Topology::build(&mesh),
+            &unit.curve,
+        )
+        .map_err(PipelineError::FileUnits)?;
         if unit.report.certificate.no_self_intersections == 1 {
             invariants::certify_no_self_intersections(&mesh).map_err(PipelineError::FileUnits)?;
         }
@@ -177,21 +200,27 @@ fn in_file_numbering(e: MetricError, map: &[Option<VertexId>]) -> MetricError {
     }
 }
 
-/// Map the unit-space result back to file units. A vertex that sits exactly on an input
-/// vertex (one-hot barycentric location, bit-identical unit position) gets that vertex's file
-/// coordinates bit for bit; every other vertex is mapped by the inverse normalization.
+/// Map the unit-space result back to file units. A vertex on a boundary curve is that curve
+/// point computed from the file's positions (so it lies on the file's boundary polyline by
+/// the same exact rule); a vertex that sits exactly on an input vertex (one-hot barycentric
+/// location, bit-identical unit position) gets that vertex's file coordinates bit for bit;
+/// every other vertex is mapped by the inverse normalization.
 fn to_file_units(
-    out: &TriMesh,
-    locations: &[SurfaceLocation],
+    unit: &RemeshResult,
     reference: &TriMesh,
     file_mesh: &TriMesh,
     norm: &Normalization,
 ) -> TriMesh {
+    let out = &unit.mesh;
     let positions = out
         .positions
         .iter()
-        .zip(locations)
-        .map(|(p, loc)| {
+        .zip(&unit.locations)
+        .enumerate()
+        .map(|(i, (p, loc))| {
+            if let Some(c) = unit.curve.get(i).copied().flatten() {
+                return unit.curves.position(file_mesh, &c);
+            }
             for k in 0..3 {
                 if loc.bary[k] == 1.0 {
                     let v = reference.triangles[loc.face.idx()][k];

@@ -1,7 +1,7 @@
 //! Algorithm 1, step (e) "replace P, and update the mesh M": stitching a remeshed patch into
 //! the working mesh (or keeping a failed one's faces), then certifying the working mesh.
 
-use super::context::{LoopState, RunContext};
+use super::context::{a_priori_at, LoopState, RunContext};
 use super::debug::write_debug;
 use super::error::{PipelineError, Stage, StageError};
 use super::step::PatchOutcome;
@@ -46,6 +46,18 @@ pub fn replace_patch(
                 .map_err(|e| stage_error(Stage::Stitching, e.into()))?;
             state.counters.times.stitch += t0.elapsed().as_secs_f64();
             let n = state.work.mesh.n_vertices();
+            let reference = ctx.quality_field.reference();
+            let first_new = n - refined.replacement.new_positions.len();
+            for (k, loc) in refined.replacement.new_locations.iter().enumerate() {
+                let rounds = refined.factors.new.get(k).copied().unwrap_or(1.0);
+                state
+                    .bound
+                    .push(a_priori_at(&ctx.plan.fid_scale, reference, loc) * rounds);
+            }
+            debug_assert_eq!(
+                state.bound.len(),
+                first_new + refined.replacement.new_locations.len()
+            );
             state
                 .factors
                 .absorb(refined.factors, ctx.plan.options.fidelity.persist, n)
@@ -143,16 +155,26 @@ fn certify_after_patch(
     Ok(())
 }
 
-/// The input's boundary edges and vertices are still those of the working mesh, bit for bit.
-pub fn certify_boundary(
-    ctx: &RunContext<'_>,
-    state: &LoopState,
-) -> Result<(), InvariantError> {
+/// The boundary of the working mesh lies on the input's boundary curves, once around each,
+/// every corner kept ([`invariants::certify_boundary_on_curves`]); without resampling also
+/// the input's boundary vertices and edges, bit for bit.
+pub fn certify_boundary(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), InvariantError> {
     if ctx.input_boundary.is_empty() {
         return Ok(());
     }
+    let reference = ctx.quality_field.reference();
+    invariants::certify_boundary_on_curves(
+        &ctx.curves,
+        reference,
+        &state.work.mesh,
+        &state.topo,
+        &state.work.curve,
+    )?;
+    if ctx.plan.options.boundary.resample {
+        return Ok(());
+    }
     invariants::certify_boundary_kept(
-        ctx.quality_field.reference(),
+        reference,
         &ctx.input_boundary,
         &state.work.mesh,
         &invariants::boundary_edges(&state.topo),

@@ -7,7 +7,7 @@ use super::options::{CoarseInput, RemeshOptions, TargetLength, COARSE_RATIO};
 use crate::fidelity;
 use crate::ids::VertexId;
 use crate::mesh::{Topology, TriMesh};
-use crate::metric::MetricField;
+use crate::metric::{apply_sizes, MetricField};
 use nalgebra::Matrix3;
 
 /// Largest expected output ([`expected_faces`] in the metric at L_tar) a run accepts.
@@ -33,7 +33,10 @@ pub struct Plan {
     pub expected_fidelity: f64,
     /// The coarse-input profile runs.
     pub coarse: bool,
-    /// The metric with the a-priori scaling applied, when there is one.
+    /// The metric with the size controls applied ([`RemeshOptions::sizes`]), when they are on:
+    /// the run's metric, for the remeshing and every measure.
+    sized: Option<MetricField>,
+    /// The run's metric with the a-priori scaling applied, when there is one.
     scaled: Option<MetricField>,
 }
 
@@ -61,6 +64,23 @@ impl Plan {
                 "target edge length {l_tar} is not a positive finite number (L_avg = {l_avg})"
             )));
         }
+        let sized =
+            match options.sizes.any() {
+                true => {
+                    let m = apply_sizes(
+                        reference,
+                        field.vertex_metrics(),
+                        l_tar,
+                        1.0,
+                        &options.sizes,
+                    );
+                    Some(MetricField::new(reference.clone(), m).map_err(|e| {
+                        PipelineError::Input(format!("size-controlled metric: {e}"))
+                    })?)
+                }
+                false => None,
+            };
+        let field = sized.as_ref().unwrap_or(field);
         let expected = expected_faces(reference, field.vertex_metrics(), &[], l_tar);
         // A target far below the input's size would run for hours and exhaust memory: refuse
         // it up front, naming the count.
@@ -112,14 +132,20 @@ impl Plan {
             expected,
             expected_fidelity,
             coarse,
+            sized,
             scaled,
         })
     }
 
-    /// The metric the patches are remeshed in: `unscaled` with the a-priori fidelity scaling,
-    /// when there is one. Every quality measure uses `unscaled`.
-    pub fn remesh_field<'a>(&'a self, unscaled: &'a MetricField) -> &'a MetricField {
-        self.scaled.as_ref().unwrap_or(unscaled)
+    /// The run's metric: `input` with the size controls applied, when they are on.
+    pub fn quality_field<'a>(&'a self, input: &'a MetricField) -> &'a MetricField {
+        self.sized.as_ref().unwrap_or(input)
+    }
+
+    /// The metric the patches are remeshed in: the run's metric with the a-priori fidelity
+    /// scaling, when there is one. Every quality measure uses the run's metric.
+    pub fn remesh_field<'a>(&'a self, input: &'a MetricField) -> &'a MetricField {
+        self.scaled.as_ref().unwrap_or(self.quality_field(input))
     }
 }
 

@@ -8,6 +8,7 @@
 //! face that enters the working mesh is certified and the unprocessed count strictly
 //! decreases (termination).
 
+use super::chains::{self, PatchDomain};
 use super::context::{Counters, LoopState, RunContext};
 use super::debug::{write_candidate, write_debug};
 use super::error::{PipelineError, Stage, StageError};
@@ -15,8 +16,7 @@ use super::records::{FailedAttempt, PatchRecord};
 use crate::fidelity::{self, PatchVertices, Refined, RoundOutput, RoundsSetup, VertexFactors};
 use crate::ids::{FaceId, PatchId};
 use crate::invariants::{self, InvariantError};
-use crate::lift::{lift, PatchFrame};
-use super::chains::{self, PatchDomain};
+use crate::lift::{lift, DomainVertex, PatchFrame};
 use crate::mesh::Topology;
 use crate::param::DistortionReport;
 use crate::patches::{extract_patch, interior_corner, interior_feature, Patch, PatchMesh};
@@ -286,7 +286,14 @@ fn attempt(
     let transfer = Transferred::new(ctx, &disk, &param.uv, &metrics3d)?;
     // The free boundary chains resampled on the input's curves, in the first round's metric.
     let round0 = transfer
-        .field(&transfer.metrics, &transfer.metrics.iter().map(|m| m.trace()).collect::<Vec<_>>())
+        .field(
+            &transfer.metrics,
+            &transfer
+                .metrics
+                .iter()
+                .map(|m| m.trace())
+                .collect::<Vec<_>>(),
+        )
         .map_err(AttemptFailure::at(Stage::MetricTransfer))?;
     let domain = chains::patch_domain(ctx, view.work, view.topo, &disk, &param.uv, &round0);
     counters.cert.chains += domain.chains;
@@ -420,7 +427,6 @@ fn remesh_and_lift(
     let refined = fidelity::refine(
         &setup,
         PatchVertices {
-            positions: &domain.positions,
             to_global: &disk.to_global,
         },
         carried,
@@ -453,7 +459,10 @@ fn remesh_and_lift(
             )
             .map_err(|e| AttemptFailure::at(Stage::MappingBack)(e.into()))?;
             counters.times.lift += t0.elapsed().as_secs_f64();
+            let (lifted, new_uv) = round_vertices(&planar, domain, &replacement);
             Ok(RoundOutput {
+                lifted,
+                new_uv,
                 planar,
                 field: planar_field,
                 replacement,
@@ -462,4 +471,33 @@ fn remesh_and_lift(
     );
     counters.times.fidelity += clock;
     refined
+}
+
+/// The 3D position of every planar vertex of a lifted round (a domain vertex's own position,
+/// else the next new vertex of the replacement: new vertices are made in planar order, a
+/// domain vertex on a curve included), and the plane position of every new vertex.
+fn round_vertices(
+    planar: &crate::mesh::PlanarMesh,
+    domain: &PatchDomain,
+    replacement: &Replacement,
+) -> (Vec<nalgebra::Point3<f64>>, Vec<nalgebra::Point2<f64>>) {
+    let mut new_uv = Vec::with_capacity(replacement.new_positions.len());
+    let lifted = planar
+        .origin
+        .iter()
+        .zip(&planar.points)
+        .map(|(origin, p)| match origin {
+            Some(i) => {
+                if matches!(domain.vertices[*i as usize], DomainVertex::Curve { .. }) {
+                    new_uv.push(*p);
+                }
+                domain.positions[*i as usize]
+            }
+            None => {
+                new_uv.push(*p);
+                replacement.new_positions[new_uv.len() - 1]
+            }
+        })
+        .collect();
+    (lifted, new_uv)
 }

@@ -154,7 +154,7 @@ pub fn evaluate(
     let t0 = Instant::now();
     let (field, source) = match input_metric {
         Some(m) => (
-            MetricField::new(
+            MetricField::from_surface_tensors(
                 unit_in.clone(),
                 m.iter().map(|x| norm.metric_to_unit(x)).collect(),
             )?,

@@ -274,9 +274,20 @@ pub struct Conformity {
 /// Edge-length conformity of `mesh` to the target length `l_tar` in the per-vertex metrics:
 /// each unique edge measured by [`edge_metric_length`], divided by `l_tar`.
 pub fn edge_conformity(mesh: &TriMesh, vertex_metrics: &[Matrix3<f64>], l_tar: f64) -> Conformity {
+    edge_conformity_where(mesh, vertex_metrics, l_tar, |_| true)
+}
+
+/// [`edge_conformity`] over the unique edges for which `keep` holds.
+pub fn edge_conformity_where(
+    mesh: &TriMesh,
+    vertex_metrics: &[Matrix3<f64>],
+    l_tar: f64,
+    keep: impl Fn(EdgeKey) -> bool,
+) -> Conformity {
     let mut r: Vec<f64> = unique_edges(mesh)
-        .iter()
-        .map(|&e| edge_metric_length(mesh, vertex_metrics, e) / l_tar)
+        .into_iter()
+        .filter(|e| keep(*e))
+        .map(|e| edge_metric_length(mesh, vertex_metrics, e) / l_tar)
         .collect();
     let n = r.len();
     if n == 0 {

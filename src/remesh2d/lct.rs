@@ -73,9 +73,15 @@ pub struct LctOptions {
     pub rebuild: bool,
     /// The spacing of the interior vertices kept for the start, times L (default 0.8).
     pub start_spacing: f64,
+    /// After split and collapse, bring the vertex count to that of an ideal mesh of the
+    /// domain's metric area (default true), so edges have length L on average.
+    pub density: bool,
 }
 
 impl Default for LctOptions {
+    /// The settings for the curvature metric at L_tar = 1.5·L_avg (the paper's protocol, measured
+    /// on the 12 shared meshes): start from the patch's own triangulation, split above 4/3 L,
+    /// collapse below 4/5 L, no density control.
     fn default() -> Self {
         LctOptions {
             rounds: 8,
@@ -91,8 +97,25 @@ impl Default for LctOptions {
             final_maxmin_flips: true,
             tensor_at_centroid: false,
             certify_every_round: true,
-            rebuild: true,
+            rebuild: false,
             start_spacing: 0.8,
+            density: false,
+        }
+    }
+}
+
+impl LctOptions {
+    /// The settings for a metric whose sizes are absolute (a user's metric at L_tar = 1): start
+    /// from the triangulated boundary with the patch's vertices `0.8·L` apart (a regular input
+    /// grid that is anisotropic in the metric is a fixed point of the local operations), split
+    /// above 1.5 L, and bring the vertex count to that of an ideal mesh, so edges are L on
+    /// average (paper-notes.md, "LCT remeshing").
+    pub fn for_absolute_sizes() -> LctOptions {
+        LctOptions {
+            split_ratio: 1.5,
+            rebuild: true,
+            density: true,
+            ..LctOptions::default()
         }
     }
 }
@@ -153,7 +176,12 @@ fn from_boundary(domain: &PlanarDomain, metric: &dyn Metric2d, spacing: f64) -> 
 
 /// The candidates (ids of `domain`'s points) at least `spacing` from the boundary vertices and
 /// from each other in the metric (mean of the two points' tensors), greedily in order.
-fn spaced(domain: &PlanarDomain, metric: &dyn Metric2d, candidates: &[u32], spacing: f64) -> Vec<u32> {
+fn spaced(
+    domain: &PlanarDomain,
+    metric: &dyn Metric2d,
+    candidates: &[u32],
+    spacing: f64,
+) -> Vec<u32> {
     if candidates.is_empty() || !(spacing > 0.0) {
         return Vec::new();
     }
@@ -177,7 +205,9 @@ fn spaced(domain: &PlanarDomain, metric: &dyn Metric2d, candidates: &[u32], spac
     let key = |p: &Point2<f64>| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
     let mut grid: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
     for &b in &domain.boundary {
-        grid.entry(key(&domain.points[b as usize])).or_default().push(b);
+        grid.entry(key(&domain.points[b as usize]))
+            .or_default()
+            .push(b);
     }
     let mut kept = Vec::new();
     for &i in candidates {
@@ -264,6 +294,17 @@ pub fn remesh_planar(
                     break;
                 }
             }
+            if options.density {
+                // An ideal mesh of metric area A has A / (√3/4·L²) faces, and a disk
+                // triangulation with b boundary vertices has (F + b + 2) / 2 vertices.
+                let faces = w.metric_area() / (3f64.sqrt() / 4.0 * target_length * target_length);
+                let target = (faces + domain.boundary.len() as f64 + 2.0) / 2.0;
+                for _ in 0..options.max_passes {
+                    if w.density_pass(target) == 0 {
+                        break;
+                    }
+                }
+            }
             if options.valence_flips {
                 w.valence_flips(options.valence_quality_guard);
             } else {
@@ -286,6 +327,9 @@ pub fn remesh_planar(
     }
     Ok(mesh)
 }
+
+/// The density pass leaves the vertex count alone within this fraction of its target.
+const DENSITY_SLACK: f64 = 0.02;
 
 /// A fast hasher for the packed `u64` half-edge keys (multiplicative, Fx-style).
 #[derive(Default)]
@@ -584,14 +628,56 @@ impl<'a> Work<'a> {
         self.touched.iter_mut().for_each(|t| *t = false);
     }
 
+    /// The metric area of the triangulation, `Σ |T|·√det M_T`.
+    fn metric_area(&self) -> f64 {
+        self.tris
+            .iter()
+            .zip(&self.alive)
+            .filter(|(_, a)| **a)
+            .map(|(t, _)| {
+                let p = t.map(|i| self.pts[i as usize]);
+                let area = 0.5 * (p[1] - p[0]).perp(&(p[2] - p[0]));
+                area * self.tri_metric(*t).determinant().max(0.0).sqrt()
+            })
+            .sum()
+    }
+
+    /// Vertices in use.
+    fn vertex_count(&self) -> usize {
+        self.valive.iter().filter(|a| **a).count()
+    }
+
+    /// Edge length adjustment, part 3 (ours): bring the vertex count to `target` (the count of
+    /// an ideal mesh of the domain's metric area, see [`remesh_planar`]) by collapsing the
+    /// shortest edges below L or splitting the longest above L, so that edges come out at L
+    /// on average rather than wherever the split and collapse thresholds leave them.
+    fn density_pass(&mut self, target: f64) -> usize {
+        let v = self.vertex_count() as f64;
+        if v > target * (1.0 + DENSITY_SLACK) {
+            self.collapse_shorter_than(self.l, (v - target).round() as usize)
+        } else if v < target * (1.0 - DENSITY_SLACK) {
+            self.split_longer_than(self.l, (target - v).round() as usize)
+        } else {
+            0
+        }
+    }
+
     /// Edge length adjustment, part 1: split every (non-adjacent) long interior edge at its
     /// midpoint. Returns the number of splits.
     fn split_pass(&mut self) -> usize {
+        self.split_longer_than(self.split * self.l, usize::MAX)
+    }
+
+    /// Split the (non-adjacent) interior edges longer than `thr`, longest first, at most
+    /// `max` of them. Returns the number of splits.
+    fn split_longer_than(&mut self, thr: f64, max: usize) -> usize {
         self.clear_touched();
-        let thr = self.split * self.l;
         let cands = self.edges_where(|l| l > thr, true);
         let mut n = 0;
         for (_, a, b) in cands {
+            if n >= max {
+                break;
+            }
             let (Some(&t1), Some(&t2)) = (self.he.get(&key(a, b)), self.he.get(&key(b, a))) else {
                 continue;
             };
@@ -627,11 +713,18 @@ impl<'a> Work<'a> {
     /// remaining triangle would not be positive (exact), or when a new edge would be longer
     /// than the split threshold. Returns the number of collapses.
     fn collapse_pass(&mut self) -> usize {
+        self.collapse_shorter_than(self.collapse * self.l, usize::MAX)
+    }
+
+    /// Collapse interior edges shorter than `thr`, shortest first, at most `max` of them.
+    fn collapse_shorter_than(&mut self, thr: f64, max: usize) -> usize {
         self.clear_touched();
-        let thr = self.collapse * self.l;
         let cands = self.edges_where(|l| l < thr, false);
         let mut n = 0;
         for (_, a, b) in cands {
+            if n >= max {
+                break;
+            }
             if !self.valive[a as usize] || !self.valive[b as usize] {
                 continue;
             }

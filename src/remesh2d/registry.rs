@@ -10,12 +10,16 @@ pub static REMESHERS: &[Entry<dyn PlanarRemesher>] = &[Entry {
     summary: "anisotropic meshing with local convex functions (ref. [5], Sec. 3.3), the paper's",
     options: &[
         OptionDoc {
+            name: "sizes",
+            doc: "the settings for absolute sizes (a user metric): start from the boundary, density control, split at 1.5 [true with --metric, else false]",
+        },
+        OptionDoc {
             name: "rounds",
             doc: "outer rounds of split/collapse, flips and smoothing [8]",
         },
         OptionDoc {
             name: "split_ratio",
-            doc: "split interior edges longer than this times L_tar [4/3]",
+            doc: "split interior edges longer than this times L_tar [4/3; 1.5 with sizes]",
         },
         OptionDoc {
             name: "collapse_ratio",
@@ -27,11 +31,15 @@ pub static REMESHERS: &[Entry<dyn PlanarRemesher>] = &[Entry {
         },
         OptionDoc {
             name: "rebuild",
-            doc: "start from the triangulated boundary polygon, not the domain's mesh [true]",
+            doc: "start from the triangulated boundary polygon, not the domain's mesh [false; true with sizes]",
         },
         OptionDoc {
             name: "start_spacing",
             doc: "with rebuild, keep the domain's interior vertices this far apart (times L_tar) [0.8]",
+        },
+        OptionDoc {
+            name: "density",
+            doc: "bring the vertex count to an ideal mesh's, so edges are L_tar on average [false; true with sizes]",
         },
         OptionDoc {
             name: "smoothing_iters",
@@ -54,7 +62,10 @@ pub fn planar_remesher(
 }
 
 fn lct(p: &mut Params) -> Result<Box<dyn PlanarRemesher>, BadValue> {
-    let mut o = LctOptions::default();
+    let mut o = match p.take("sizes", "true or false")? {
+        Some(true) => LctOptions::for_absolute_sizes(),
+        _ => LctOptions::default(),
+    };
     let ratio = |x: f64| x.is_finite() && x > 0.0;
     if let Some(r) = p.take("rounds", "a number of rounds")? {
         o.rounds = r;
@@ -69,14 +80,21 @@ fn lct(p: &mut Params) -> Result<Box<dyn PlanarRemesher>, BadValue> {
     })? {
         o.collapse_ratio = r;
     }
-    if let Some(g) = p.take_checked("collapse_guard", "a number above 1", |x: f64| ratio(x) && x > 1.0)? {
+    if let Some(g) = p.take_checked("collapse_guard", "a number above 1", |x: f64| {
+        ratio(x) && x > 1.0
+    })? {
         o.collapse_guard = Some(g);
     }
     if let Some(b) = p.take("rebuild", "true or false")? {
         o.rebuild = b;
     }
-    if let Some(x) = p.take_checked("start_spacing", "a number ≥ 0", |x: f64| x.is_finite() && x >= 0.0)? {
+    if let Some(x) = p.take_checked("start_spacing", "a number ≥ 0", |x: f64| {
+        x.is_finite() && x >= 0.0
+    })? {
         o.start_spacing = x;
+    }
+    if let Some(b) = p.take("density", "true or false")? {
+        o.density = b;
     }
     if let Some(n) = p.take("smoothing_iters", "a number of passes")? {
         o.smoothing_iters = n;

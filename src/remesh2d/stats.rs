@@ -22,6 +22,8 @@ pub struct PlanarQuality {
     /// Fraction of edges whose metric length (tensor at the edge midpoint) is in
     /// `[L/√2, √2·L]`.
     pub edges_in_range: f64,
+    /// Mean metric edge length over L.
+    pub edge_mean: f64,
 }
 
 /// The metric side lengths `[|p1p2|, |p2p0|, |p0p1|]` of a planar triangle in the tensor
@@ -77,16 +79,19 @@ pub fn planar_quality(
         .collect();
     edges.sort_unstable();
     edges.dedup();
-    let inr = edges
+    let lengths: Vec<f64> = edges
         .iter()
-        .filter(|(a, b)| {
+        .map(|(a, b)| {
             let (pa, pb) = (mesh.points[*a as usize], mesh.points[*b as usize]);
             let mid = Point2::from((pa.coords + pb.coords) * 0.5);
             let m = metric.metric(&mid);
             let e = pb - pa;
-            let l = e.dot(&(m * e)).max(0.0).sqrt() / target_length;
-            (std::f64::consts::FRAC_1_SQRT_2..=std::f64::consts::SQRT_2).contains(&l)
+            e.dot(&(m * e)).max(0.0).sqrt() / target_length
         })
+        .collect();
+    let inr = lengths
+        .iter()
+        .filter(|l| (std::f64::consts::FRAC_1_SQRT_2..=std::f64::consts::SQRT_2).contains(*l))
         .count();
     let nf = mesh.triangles.len().max(1) as f64;
     PlanarQuality {
@@ -97,5 +102,6 @@ pub fn planar_quality(
         theta_min_deg: tmin,
         theta_avg_deg: tsum / nf,
         edges_in_range: inr as f64 / edges.len().max(1) as f64,
+        edge_mean: lengths.iter().sum::<f64>() / lengths.len().max(1) as f64,
     }
 }

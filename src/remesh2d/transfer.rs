@@ -171,8 +171,6 @@ fn pullback(
         .collect())
 }
 
-
-
 /// Eq. 4: fit the in-plane rotation of the principal frame from the 1-ring, then `D K Dᵀ`.
 fn principal_fit(
     disk: &TriMesh,
