@@ -75,7 +75,7 @@ pub(crate) fn finish_patch(
     cone: Option<Cone>,
     max_growth_cost: Option<f64>,
 ) -> Result<Patch, PatchError> {
-    let faces = disk.sorted_faces();
+    let faces = super::expand::trim_ragged(ctx, disk.sorted_faces());
     let boundary = crate::invariants::certify_disk(ctx.mesh, &faces).map_err(|source| {
         PatchError::NotCertified {
             patch: None,

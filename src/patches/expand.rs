@@ -8,6 +8,8 @@
 //! become a corner once its neighbour joins).
 
 use super::grow::DiskPatch;
+use super::PatchContext;
+use crate::ids::{EdgeKey, FaceId, VertexId};
 
 /// Add up to `rings` rings of processed faces to `patch`; returns the number added.
 pub fn expand_rings(patch: &mut DiskPatch<'_, '_>, processed: &[bool], rings: usize) -> usize {
@@ -31,4 +33,53 @@ pub fn expand_rings(patch: &mut DiskPatch<'_, '_>, processed: &[bool], rings: us
         }
     }
     added
+}
+
+/// The patch with its ragged expansion trimmed: while more than half of its vertices are on
+/// its boundary (rings of needle-shaped faces, as an anisotropic earlier remesh leaves them,
+/// make a comb), remove the processed faces with two edges on the patch boundary (ears),
+/// which keeps a disk and its unprocessed faces. Returns `faces` unchanged otherwise.
+pub fn trim_ragged(ctx: &PatchContext<'_>, faces: Vec<FaceId>) -> Vec<FaceId> {
+    use std::collections::HashMap;
+    let mesh = ctx.mesh;
+    let processed = |f: FaceId| ctx.processed.get(f.idx()).copied().unwrap_or(false);
+    let mut faces = faces;
+    for _ in 0..4 {
+        let mut edges: HashMap<EdgeKey, u32> = HashMap::new();
+        let mut vertices: HashMap<VertexId, u32> = HashMap::new();
+        for &f in &faces {
+            let t = mesh.face(f);
+            for k in 0..3 {
+                *edges.entry(EdgeKey::new(t[k], t[(k + 1) % 3])).or_default() += 1;
+                *vertices.entry(t[k]).or_default() += 1;
+            }
+        }
+        let on_boundary: std::collections::HashSet<VertexId> = edges
+            .iter()
+            .filter(|(_, n)| **n == 1)
+            .flat_map(|(e, _)| [e.0, e.1])
+            .collect();
+        if 2 * on_boundary.len() <= vertices.len() || faces.len() < 4 {
+            break;
+        }
+        let boundary_edges = |f: FaceId| {
+            let t = mesh.face(f);
+            (0..3)
+                .filter(|&k| edges[&EdgeKey::new(t[k], t[(k + 1) % 3])] == 1)
+                .count()
+        };
+        let before = faces.len();
+        let kept: Vec<FaceId> = faces
+            .iter()
+            .copied()
+            .filter(|&f| !(processed(f) && boundary_edges(f) == 2))
+            .collect();
+        // Ears of one another (two ears sharing their third edge) would leave nothing in
+        // between: keep the patch when trimming would empty it of processed faces' support.
+        if kept.len() == before || kept.iter().all(|&f| processed(f)) {
+            break;
+        }
+        faces = kept;
+    }
+    faces
 }
