@@ -10,6 +10,7 @@
 //! - [`lift`], [`stitch`]: Sec. 3.3 "Mapping back", patch replacement.
 //! - [`pipeline`]: Algorithm 1.
 //! - [`quality`], [`report`]: Sec. 4.1, the yardstick.
+//! - [`suite`]: the analytic benchmark cases (surfaces with user-style metrics).
 
 pub mod check;
 pub mod error;
@@ -29,6 +30,7 @@ pub mod quality;
 pub mod remesh2d;
 pub mod report;
 pub mod stitch;
+pub mod suite;
 
 pub use error::{Error, Result};
 pub use ids::{EdgeKey, FaceId, HalfedgeId, PatchId, VertexId};
