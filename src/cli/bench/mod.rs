@@ -34,10 +34,12 @@ pub struct BenchArgs {
     #[arg(conflicts_with = "suite")]
     pub meshes: Vec<PathBuf>,
     /// Folder whose meshes run when none are named.
-    #[arg(long, default_value = "../shared/meshes")]
+    #[arg(long, default_value = "../shared/meshes", conflicts_with = "suite")]
     pub dir: PathBuf,
     /// Folder for the outputs: `remesh.md` (the table), and per mesh `NAME.obj`, `NAME.json`
-    /// (the remesh report) and `NAME.log` (its stdout and stderr).
+    /// (the remesh report) and `NAME.log` (its stdout and stderr). With `--suite`:
+    /// `analytic.md`, and per case its input `NAME.mesh` + `NAME.sol`, then per tool (`conemesh`,
+    /// `mmg`) `NAME-TOOL.obj`/`.mesh`, `NAME-TOOL-eval.json` and `NAME-TOOL.log`.
     #[arg(short, long, default_value = "bench")]
     pub out_dir: PathBuf,
     /// Further arguments for every `conemesh remesh` run, after `--`
