@@ -16,6 +16,8 @@
 //! - [`improve`]: Sec. 3.4, connectivity and vertex position updates on the surface.
 //! - [`quality`], [`report`]: Sec. 4.1, the yardstick; JSON and plots.
 //! - [`registry`], [`contract`]: the extension points' tables and their contract checks.
+//! - [`boundary`]: the input's boundary curves the output's boundary lies on (ours).
+//! - [`suite`]: the analytic benchmark cases (surfaces with user-style metrics).
 
 pub mod boundary;
 pub mod check;
@@ -39,6 +41,7 @@ pub mod registry;
 pub mod remesh2d;
 pub mod report;
 pub mod stitch;
+pub mod suite;
 
 pub use error::{Error, Result};
 pub use ids::{EdgeKey, FaceId, HalfedgeId, PatchId, VertexId};

@@ -17,7 +17,8 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Benchmark `remesh` on a folder of meshes (the shared meshes): quality, Hausdorff
-    /// distance, time and peak memory per mesh, as a Markdown table.
+    /// distance, time and peak memory per mesh, as a Markdown table; with `--suite analytic`,
+    /// conemesh and MMG side by side on generated surfaces with user-style metrics.
     Bench(cli::bench::BenchArgs),
     /// Check a mesh: topology, manifoldness, degenerate faces, self-intersections.
     Check(cli::check::CheckArgs),

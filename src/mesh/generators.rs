@@ -1,6 +1,7 @@
 //! Test surfaces generated in code (seeded where random): icosphere, torus, genus-g
-//! plate, open cylinder, disk, cone and cylinder pieces, and random perturbations.
-//! Every generator returns a consistently oriented manifold with outward normals.
+//! plate, open cylinder, flat square plate, disk, disk with holes, cone and cylinder pieces,
+//! and random perturbations. Every generator returns a consistently oriented manifold with
+//! outward normals.
 
 use super::TriMesh;
 use crate::ids::VertexId;
@@ -8,6 +9,18 @@ use nalgebra::{Point3, Vector3};
 use rand::Rng;
 use std::collections::HashMap;
 use std::f64::consts::PI;
+use thiserror::Error;
+
+/// Why a generator could not build its surface (only [`disk_with_holes`] can fail).
+#[derive(Debug, Error)]
+pub enum GeneratorError {
+    /// The parameters describe no surface (a hole outside the disk, overlapping holes, ...).
+    #[error("invalid parameters: {0}")]
+    InvalidParameters(String),
+    /// The constrained Delaunay triangulation refused the points.
+    #[error("triangulation failed: {0}")]
+    Triangulation(String),
+}
 
 fn build(positions: Vec<Point3<f64>>, tris: Vec<[usize; 3]>) -> TriMesh {
     TriMesh {
@@ -150,6 +163,15 @@ pub fn cylinder(r: f64, h: f64, nu: usize, nv: usize) -> TriMesh {
     })
 }
 
+/// Flat square plate `[0, size]²` in the xy plane (normal +z): `cells`×`cells` grid cells,
+/// each split into two triangles (alternating diagonals). One boundary loop, genus 0.
+pub fn plate(size: f64, cells: usize) -> TriMesh {
+    let n = cells.max(1);
+    grid(n, n, false, false, |i, j| {
+        Point3::new(size * i as f64 / n as f64, size * j as f64 / n as f64, 0.0)
+    })
+}
+
 /// Piece of a cylinder of radius `r` over the angle range `[0, angle]` and height `h`
 /// (a developable disk).
 pub fn cylinder_piece(r: f64, angle: f64, h: f64, nu: usize, nv: usize) -> TriMesh {
@@ -257,6 +279,157 @@ pub fn disk(r: f64, rings: usize, sectors: usize) -> TriMesh {
         }
     }
     build(pos, tris)
+}
+
+/// A hole of [`disk_with_holes`]: a circle of the xy plane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hole {
+    /// Centre (x, y).
+    pub centre: [f64; 2],
+    /// Radius.
+    pub radius: f64,
+}
+
+/// Flat disk of radius `r` centred at the origin of the xy plane (normal +z) with circular
+/// `holes`, meshed at about `spacing`: the outer circle and every hole circle are polygons with
+/// sides of at most `spacing` (vertices on the circles); around every hole, one ring of
+/// vertices at each distance of `wall_layers` (ascending, as in a boundary-layer mesh: fine
+/// normal to the wall, `spacing` along it); the rest a triangular lattice of side `spacing`
+/// (points closer than 0.6·spacing to a circle or the last ring dropped); triangulated by
+/// spade's constrained Delaunay triangulation. `1 + holes.len()` boundary loops, genus 0.
+/// Each hole with its rings must lie inside the disk and apart from the others by at least
+/// `spacing`.
+pub fn disk_with_holes(
+    r: f64,
+    holes: &[Hole],
+    spacing: f64,
+    wall_layers: &[f64],
+) -> Result<TriMesh, GeneratorError> {
+    let reach = wall_layers.last().copied().unwrap_or(0.0);
+    check_holes(r, holes, spacing, wall_layers)?;
+    // The circles' polygons are the constraints; the rings are free points.
+    let mut points: Vec<[f64; 2]> = Vec::new();
+    let mut edges: Vec<[usize; 2]> = Vec::new();
+    let mut add_circle = |c: [f64; 2], rad: f64, points: &mut Vec<[f64; 2]>, constrain: bool| {
+        let n = ((2.0 * PI * rad / spacing).ceil() as usize).max(8);
+        let first = points.len();
+        for k in 0..n {
+            let a = 2.0 * PI * k as f64 / n as f64;
+            points.push([c[0] + rad * a.cos(), c[1] + rad * a.sin()]);
+            if constrain {
+                edges.push([first + k, first + (k + 1) % n]);
+            }
+        }
+    };
+    add_circle([0.0, 0.0], r, &mut points, true);
+    for h in holes {
+        add_circle(h.centre, h.radius, &mut points, true);
+        for d in wall_layers {
+            add_circle(h.centre, h.radius + d, &mut points, false);
+        }
+    }
+    // Lattice rows √3/2·spacing apart, every other row shifted by half a side.
+    let clearance = 0.6 * spacing;
+    let dy = spacing * 3f64.sqrt() / 2.0;
+    let (rows, cols) = ((r / dy).ceil() as i64, (r / spacing).ceil() as i64 + 1);
+    for j in -rows..=rows {
+        let y = j as f64 * dy;
+        let shift = if j.rem_euclid(2) == 1 {
+            0.5 * spacing
+        } else {
+            0.0
+        };
+        for i in -cols..=cols {
+            let x = i as f64 * spacing + shift;
+            let clear_of_holes = holes
+                .iter()
+                .all(|h| (x - h.centre[0]).hypot(y - h.centre[1]) >= h.radius + reach + clearance);
+            if clear_of_holes && x.hypot(y) <= r - clearance {
+                points.push([x, y]);
+            }
+        }
+    }
+    let verts: Vec<spade::Point2<f64>> = points
+        .iter()
+        .map(|p| spade::Point2::new(p[0], p[1]))
+        .collect();
+    let mut conflict = false;
+    let cdt: spade::ConstrainedDelaunayTriangulation<spade::Point2<f64>> =
+        spade::ConstrainedDelaunayTriangulation::try_bulk_load_cdt(verts, edges, |_| {
+            conflict = true
+        })
+        .map_err(|e| GeneratorError::Triangulation(format!("{e:?}")))?;
+    if conflict {
+        return Err(GeneratorError::Triangulation(
+            "crossing circle sides".into(),
+        ));
+    }
+    use spade::Triangulation as _;
+    let positions: Vec<Point3<f64>> = cdt
+        .vertices()
+        .map(|v| Point3::new(v.position().x, v.position().y, 0.0))
+        .collect();
+    // The CDT covers the convex hull, i.e. the outer polygon; drop the faces inside a hole
+    // polygon. A face never crosses a hole's sides (constraints), so its centroid decides, and a
+    // centroid inside the polygon lies inside the (circumscribed) circle.
+    let tris: Vec<[usize; 3]> = cdt
+        .inner_faces()
+        .map(|f| f.vertices().map(|v| v.fix().index()))
+        .filter(|t| {
+            let c = t.iter().fold([0.0, 0.0], |s, &v| {
+                [s[0] + positions[v].x / 3.0, s[1] + positions[v].y / 3.0]
+            });
+            holes
+                .iter()
+                .all(|h| (c[0] - h.centre[0]).hypot(c[1] - h.centre[1]) > h.radius)
+        })
+        .collect();
+    Ok(build(positions, tris).without_unreferenced_vertices().0)
+}
+
+/// The rules of [`disk_with_holes`]'s parameters.
+fn check_holes(
+    r: f64,
+    holes: &[Hole],
+    spacing: f64,
+    wall_layers: &[f64],
+) -> Result<(), GeneratorError> {
+    let bad = |s: String| Err(GeneratorError::InvalidParameters(s));
+    if !(r > 0.0 && r.is_finite() && spacing > 0.0 && spacing < r) {
+        return bad(format!(
+            "radius {r} and spacing {spacing} (need 0 < spacing < radius)"
+        ));
+    }
+    // The lattice has (r/spacing)² points; refuse sizes beyond any use.
+    if r / spacing > 1e4 {
+        return bad(format!("radius / spacing = {} (at most 1e4)", r / spacing));
+    }
+    if !wall_layers.windows(2).all(|w| w[0] < w[1])
+        || wall_layers.first().is_some_and(|d| d.is_nan() || *d <= 0.0)
+    {
+        return bad(format!(
+            "wall layers {wall_layers:?} (need positive and ascending)"
+        ));
+    }
+    let reach = wall_layers.last().copied().unwrap_or(0.0);
+    for (i, h) in holes.iter().enumerate() {
+        let d = h.centre[0].hypot(h.centre[1]);
+        if !(h.radius > 0.0 && d + h.radius + reach + spacing <= r) {
+            return bad(format!(
+                "hole {i} (centre {:?}, radius {}) with its wall layers is not inside the disk by a spacing",
+                h.centre, h.radius
+            ));
+        }
+        for (k, g) in holes.iter().enumerate().skip(i + 1) {
+            let d = (h.centre[0] - g.centre[0]).hypot(h.centre[1] - g.centre[1]);
+            if d < h.radius + g.radius + 2.0 * reach + spacing {
+                return bad(format!(
+                    "holes {i} and {k} with their wall layers are closer than a spacing"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Closed surface of genus `g` (g ≥ 0): a thickened rectangular plate with `g` square
@@ -368,6 +541,28 @@ mod tests {
             ("cylinder_piece", cylinder_piece(1.0, 2.0, 1.0, 10, 5), 0, 1),
             ("cone_piece", cone_piece(0.5, 2.0, 0.5, 2.0, 10, 5), 0, 1),
             ("disk", disk(1.0, 5, 6), 0, 1),
+            ("plate", plate(1.0, 6), 0, 1),
+            (
+                "disk_with_holes",
+                disk_with_holes(
+                    1.0,
+                    &[
+                        Hole {
+                            centre: [0.4, 0.0],
+                            radius: 0.2,
+                        },
+                        Hole {
+                            centre: [-0.4, 0.1],
+                            radius: 0.15,
+                        },
+                    ],
+                    0.1,
+                    &[0.01, 0.03],
+                )
+                .unwrap(),
+                0,
+                3,
+            ),
             ("genus0", genus_plate(0, 2), 0, 0),
             ("genus1", genus_plate(1, 1), 1, 0),
             ("genus3", genus_plate(3, 2), 3, 0),
@@ -409,6 +604,27 @@ mod tests {
             })
             .sum();
         assert!((vol - 4.0 / 3.0 * PI * 8.0).abs() / vol < 0.01);
+    }
+
+    #[test]
+    fn disk_with_holes_refuses_holes_outside_or_overlapping() {
+        let h = |x: f64, r: f64| Hole {
+            centre: [x, 0.0],
+            radius: r,
+        };
+        for (holes, what) in [
+            (vec![h(0.9, 0.2)], "not inside the disk"),
+            (vec![h(0.3, 0.2), h(-0.05, 0.2)], "closer than a spacing"),
+            (vec![h(0.0, -0.1)], "not inside the disk"),
+        ] {
+            let e = disk_with_holes(1.0, &holes, 0.05, &[])
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(what), "{e}");
+        }
+        assert!(disk_with_holes(1.0, &[], 2.0, &[]).is_err());
+        let e = disk_with_holes(1.0, &[h(0.0, 0.2)], 0.05, &[0.02, 0.01]).unwrap_err();
+        assert!(e.to_string().contains("ascending"), "{e}");
     }
 
     #[test]

@@ -5,6 +5,11 @@
 //!
 //! Each mesh runs in its own process so that its peak resident memory is its own (the child
 //! reports `VmHWM` in its JSON report) and a failing mesh cannot take the others down.
+//!
+//! `conemesh bench --suite analytic` runs the generated analytic suite instead, conemesh and
+//! MMG side by side ([`analytic`]).
+
+mod analytic;
 
 use anyhow::{bail, Context};
 use std::fmt::Write as _;
@@ -15,23 +20,63 @@ use std::time::Instant;
 /// The extensions `conemesh` reads (see `conemesh::io`).
 const MESH_EXTENSIONS: [&str; 5] = ["obj", "off", "ply", "stl", "mesh"];
 
+/// The generated suites of `--suite`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Suite {
+    /// Surfaces with user-style metrics (`conemesh::suite::ANALYTIC`): conemesh and MMG.
+    Analytic,
+}
+
 /// Arguments of `conemesh bench`.
 #[derive(clap::Args, Debug)]
 pub struct BenchArgs {
     /// Meshes to run; without any, every mesh file in `--dir`, by name.
+    #[arg(conflicts_with = "suite")]
     pub meshes: Vec<PathBuf>,
     /// Folder whose meshes run when none are named.
-    #[arg(long, default_value = "../shared/meshes")]
+    #[arg(long, default_value = "../shared/meshes", conflicts_with = "suite")]
     pub dir: PathBuf,
     /// Folder for the outputs: `remesh.md` (the table), and per mesh `NAME.obj`, `NAME.json`
-    /// (the remesh report) and `NAME.log` (its stdout and stderr).
+    /// (the remesh report) and `NAME.log` (its stdout and stderr). With `--suite`:
+    /// `analytic.md`, and per case its input `NAME.mesh` + `NAME.sol`, then per tool (`conemesh`,
+    /// `mmg`) `NAME-TOOL.obj`/`.mesh`, `NAME-TOOL-eval.json` and `NAME-TOOL.log`.
     #[arg(short, long, default_value = "bench")]
     pub out_dir: PathBuf,
     /// Further arguments for every `conemesh remesh` run, after `--`
     /// (e.g. `conemesh bench -- --sweeps 2 --seed 3`).
     #[arg(last = true)]
     pub remesh_args: Vec<String>,
+    /// Run a generated suite instead of mesh files: its cases are written into `--out-dir`
+    /// (`NAME.mesh`, `NAME.sol`), conemesh and MMG (when found) run on each, both scored by
+    /// `conemesh eval` at L_tar = 1; the table is `analytic.md`.
+    #[arg(long, value_enum)]
+    pub suite: Option<Suite>,
+    /// Suite only: run the cases whose name contains SUBSTRING (repeatable; default all).
+    #[arg(long = "case", value_name = "SUBSTRING", requires = "suite")]
+    pub cases: Vec<String>,
+    /// Suite only: MMG's surface remesher [default: `mmgs_O3` on PATH, else $CONEMESH_MMG;
+    /// without one the MMG rows say "not installed"].
+    #[arg(long, value_name = "PATH", requires = "suite")]
+    pub mmg: Option<PathBuf>,
+    /// Suite only: wall-clock limit of every child process, seconds (past it the child is
+    /// killed and its row is FAILED).
+    #[arg(long, value_name = "SECONDS", default_value_t = 900.0)]
+    pub timeout: f64,
 }
+
+/// Remesh arguments bench sets itself for every run: a second value would only make every
+/// run fail (the suite also sets the metric and L_tar).
+fn refuse_own_args(remesh_args: &[String], own: &[&str]) -> anyhow::Result<()> {
+    if let Some(a) = remesh_args.iter().find(|a| {
+        let name = a.split('=').next().unwrap_or(a);
+        own.contains(&name)
+    }) {
+        bail!("`{a}` is set by bench for every run; leave it out of the remesh arguments");
+    }
+    Ok(())
+}
+
+const OWN_ARGS: [&str; 5] = ["-o", "--output", "--report", "-q", "--quiet"];
 
 /// The targets of Algorithm 1 before minimum-angle improvement (issue 9, the paper's Table 1
 /// level), measured by `eval` against the input at the run's L_tar.
@@ -117,6 +162,9 @@ impl Numbers {
 
 /// Run `conemesh bench`.
 pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
+    if let Some(Suite::Analytic) = args.suite {
+        return analytic::run(&args);
+    }
     let meshes = if args.meshes.is_empty() {
         meshes_in(&args.dir)?
     } else {
@@ -125,13 +173,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
     if meshes.is_empty() {
         bail!("no mesh files in {}", args.dir.display());
     }
-    // bench sets these itself; a second value would only make every run fail.
-    if let Some(a) = args.remesh_args.iter().find(|a| {
-        let name = a.split('=').next().unwrap_or(a);
-        ["-o", "--output", "--report", "-q", "--quiet"].contains(&name)
-    }) {
-        bail!("`{a}` is set by bench for every run; leave it out of the remesh arguments");
-    }
+    refuse_own_args(&args.remesh_args, &OWN_ARGS)?;
     // Outputs are named by the input's file stem: two inputs with one stem would overwrite
     // each other's output, report and log.
     let mut stems: Vec<(String, &PathBuf)> = meshes.iter().map(|m| (stem(m), m)).collect();
@@ -171,12 +213,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
         // A stale report must not be read as this run's, nor a stale mesh stand beside a
         // failed run.
         for stale in [&report, &out] {
-            match std::fs::remove_file(stale) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(e).with_context(|| format!("removing {}", stale.display()));
-                }
-                _ => {}
-            }
+            remove_stale(stale)?;
         }
         let t0 = Instant::now();
         let child = Command::new(&exe)
@@ -205,18 +242,10 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
                 })
                 .and_then(|j| Numbers::from_report(&j))
         } else {
-            let stderr = String::from_utf8_lossy(&child.stderr);
-            // The error line (or a panic's message), not a trailing hint.
-            let last = stderr.lines().find(|l| l.contains("panicked")).or_else(|| {
-                stderr
-                    .lines()
-                    .rev()
-                    .find(|l| !l.trim().is_empty() && !l.starts_with("note:"))
-            });
             Err(format!(
                 "remesh failed ({}): {}",
                 child.status,
-                last.unwrap_or("no message")
+                error_line(&String::from_utf8_lossy(&child.stderr))
             ))
         };
         let row = Row {
@@ -239,6 +268,32 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Remove a previous run's output, so that it is not read as this run's nor left beside a
+/// failed run.
+fn remove_stale(path: &Path) -> anyhow::Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(e).with_context(|| format!("removing {}", path.display()))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The line of a failed child's stderr that names the error (or a panic's message), not a
+/// trailing hint.
+fn error_line(stderr: &str) -> &str {
+    stderr
+        .lines()
+        .find(|l| l.contains("panicked"))
+        .or_else(|| {
+            stderr
+                .lines()
+                .rev()
+                .find(|l| !l.trim().is_empty() && !l.starts_with("note:"))
+        })
+        .unwrap_or("no message")
 }
 
 /// A mesh's name in the table and in its output files: the file stem.
