@@ -53,7 +53,8 @@ impl Parameterizer for WrapP {
         if let Ok(dir) = std::env::var("DUMP") {
             static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
             let k = N.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-            let _ = conemesh::io::write_mesh(std::path::Path::new(&format!("{dir}/patch{k}.obj")), d);
+            let _ =
+                conemesh::io::write_mesh(std::path::Path::new(&format!("{dir}/patch{k}.obj")), d);
         }
         if let Ok(p) = &r {
             if std::env::var("V").is_ok() {

@@ -282,7 +282,11 @@ fn bad_arguments_are_errors_that_name_the_problem() {
     let o = bench(&["--case", "plate-iso"], dir.path());
     assert_eq!(o.status.code(), Some(2), "--case needs --suite");
     let o = bench(&["--suite", "analytic", "--dir", s(dir.path())], dir.path());
-    assert_eq!(o.status.code(), Some(2), "a folder and a suite exclude each other");
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "a folder and a suite exclude each other"
+    );
     assert!(err(&o).contains("cannot be used with"), "{}", err(&o));
 
     let missing = dir.path().join("no-mmg-here");

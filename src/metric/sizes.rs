@@ -112,10 +112,11 @@ fn clamp_tangent(
 
 /// The gradation of the module docs, in place, over the mesh's edges.
 fn grade(mesh: &TriMesh, metrics: &mut [Matrix3<f64>], ln_beta: f64) {
-    let edges = crate::quality::unique_edges(mesh);
+    let topo = crate::mesh::Topology::build(mesh);
+    let edges = topo.edges();
     for _ in 0..MAX_GRADATION_PASSES {
         let mut changed = false;
-        for e in &edges {
+        for e in edges {
             let (a, b) = (e.0.idx(), e.1.idx());
             let d = mesh.positions[b] - mesh.positions[a];
             for (p, q) in [(a, b), (b, a)] {

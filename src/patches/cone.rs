@@ -75,7 +75,25 @@ pub(crate) fn finish_patch(
     cone: Option<Cone>,
     max_growth_cost: Option<f64>,
 ) -> Result<Patch, PatchError> {
-    let faces = super::expand::trim_ragged(ctx, disk.sorted_faces());
+    finish_faces(
+        disk.sorted_faces(),
+        ctx,
+        seed_vertex,
+        seed_face,
+        cone,
+        max_growth_cost,
+    )
+}
+
+/// [`finish_patch`] of a face set (sorted).
+fn finish_faces(
+    faces: Vec<FaceId>,
+    ctx: &PatchContext<'_>,
+    seed_vertex: VertexId,
+    seed_face: FaceId,
+    cone: Option<Cone>,
+    max_growth_cost: Option<f64>,
+) -> Result<Patch, PatchError> {
     let boundary = crate::invariants::certify_disk(ctx.mesh, &faces).map_err(|source| {
         PatchError::NotCertified {
             patch: None,
@@ -137,8 +155,12 @@ impl PatchStrategy for ConePatches {
         }
         let max_cost = grown.max_cost();
         expand_rings(&mut grown.patch, ctx.processed, self.options.expand_rings);
-        finish_patch(
-            &grown.patch,
+        let faces = match self.options.trim_ragged {
+            true => super::expand::trim_ragged(ctx, grown.patch.sorted_faces()),
+            false => grown.patch.sorted_faces(),
+        };
+        finish_faces(
+            faces,
             ctx,
             seed_vertex,
             seed_face,

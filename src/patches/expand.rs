@@ -35,14 +35,39 @@ pub fn expand_rings(patch: &mut DiskPatch<'_, '_>, processed: &[bool], rings: us
     added
 }
 
-/// The patch with its ragged expansion trimmed: while more than half of its vertices are on
-/// its boundary (rings of needle-shaped faces, as an anisotropic earlier remesh leaves them,
-/// make a comb), remove the processed faces with two edges on the patch boundary (ears),
-/// which keeps a disk and its unprocessed faces. Returns `faces` unchanged otherwise.
+/// A face with `longest edge² / area` above this is a needle (an equilateral triangle has
+/// 2.3, a right isosceles one 4; a metric-equilateral one at 10:1 about 23).
+pub const NEEDLE_ASPECT: f64 = 15.0;
+
+/// The patch with its ragged expansion trimmed: when its processed faces are needles (the
+/// median of `longest edge² / area` above [`NEEDLE_ASPECT`], as an earlier remesh in a strongly
+/// anisotropic metric leaves them) and more than half of its vertices are on its boundary
+/// (rings of needles make a comb, which no parameterizer maps well), remove the processed
+/// faces with two edges on the patch boundary (ears), which keeps a disk and its unprocessed
+/// faces. Returns `faces` unchanged otherwise.
 pub fn trim_ragged(ctx: &PatchContext<'_>, faces: Vec<FaceId>) -> Vec<FaceId> {
     use std::collections::HashMap;
     let mesh = ctx.mesh;
     let processed = |f: FaceId| ctx.processed.get(f.idx()).copied().unwrap_or(false);
+    let mut aspects: Vec<f64> = faces
+        .iter()
+        .filter(|f| processed(**f))
+        .map(|&f| {
+            let [a, b, c] = mesh.face_points(f);
+            let h = (b - a)
+                .norm_squared()
+                .max((c - b).norm_squared())
+                .max((a - c).norm_squared());
+            h / mesh.face_area(f).max(f64::MIN_POSITIVE)
+        })
+        .collect();
+    if aspects.is_empty() {
+        return faces;
+    }
+    aspects.sort_unstable_by(f64::total_cmp);
+    if aspects[aspects.len() / 2] <= NEEDLE_ASPECT {
+        return faces;
+    }
     let mut faces = faces;
     for _ in 0..4 {
         let mut edges: HashMap<EdgeKey, u32> = HashMap::new();

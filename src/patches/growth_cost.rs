@@ -33,6 +33,10 @@ pub struct ConeOptions {
     /// Upper bound on the faces added by growth (not counting expansion); `None` = no bound.
     /// Default `None` (the paper has none).
     pub max_faces: Option<usize>,
+    /// Trim a ragged expansion through needle faces ([`super::expand::trim_ragged`]): on for
+    /// metrics with absolute sizes (a user's metric), whose earlier patches leave needles.
+    /// Default `false`.
+    pub trim_ragged: bool,
 }
 
 impl Default for ConeOptions {
@@ -43,6 +47,7 @@ impl Default for ConeOptions {
             expand_rings: 2,
             refit_rounds: 1,
             max_faces: None,
+            trim_ragged: false,
         }
     }
 }

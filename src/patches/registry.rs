@@ -30,6 +30,10 @@ pub static STRATEGIES: &[Entry<dyn PatchStrategy>] = &[
                 name: "max_faces",
                 doc: "largest number of faces added by growth [no limit]",
             },
+            OptionDoc {
+                name: "sizes",
+                doc: "absolute sizes (a user metric): trim expansions through needle faces [true with --metric, else false]",
+            },
         ],
         build: cone,
     },
@@ -81,6 +85,9 @@ fn cone(p: &mut Params) -> Result<Box<dyn PatchStrategy>, BadValue> {
     }
     if let Some(m) = p.take_checked("max_faces", "a positive number of faces", |m: usize| m > 0)? {
         o.max_faces = Some(m);
+    }
+    if let Some(t) = p.take("sizes", "true or false")? {
+        o.trim_ragged = t;
     }
     Ok(Box::new(ConePatches { options: o }))
 }

@@ -192,10 +192,16 @@ impl Default for Stages {
 }
 
 impl Stages {
-    /// The paper's stages with the planar remesher set for absolute sizes
-    /// ([`crate::remesh2d::LctOptions::for_absolute_sizes`]): the default with a user metric.
+    /// The paper's stages set for absolute sizes (cone patches that trim ragged expansions,
+    /// [`crate::remesh2d::LctOptions::for_absolute_sizes`]): the default with a user metric.
     pub fn for_user_metric() -> Stages {
         Stages {
+            patches: Box::new(ConePatches {
+                options: crate::patches::ConeOptions {
+                    trim_ragged: true,
+                    ..Default::default()
+                },
+            }),
             remesher: Box::new(Lct {
                 options: crate::remesh2d::LctOptions::for_absolute_sizes(),
             }),
@@ -204,22 +210,35 @@ impl Stages {
     }
 
     /// The stages of registry rows by name, each with its `KEY=VALUE` options. With a
-    /// `user_metric`, a planar remesher that has a `sizes` option gets `sizes=true` unless it
-    /// is given (absolute sizes; as [`Stages::for_user_metric`]).
+    /// `user_metric`, a patch strategy or planar remesher that has a `sizes` option gets
+    /// `sizes=true` unless it is given (absolute sizes; as [`Stages::for_user_metric`]).
     pub fn from_registry(
         strategy: (&str, Params),
         parameterizer: (&str, Params),
         remesher: (&str, Params),
         user_metric: bool,
     ) -> Result<Stages, RegistryError> {
-        let (name, mut params) = remesher;
-        let declares_sizes = crate::remesh2d::REMESHERS
+        let with_sizes = |table_names: &[(&str, bool)], (name, mut params): (&str, Params)| {
+            let declares = table_names.iter().any(|(n, has)| *n == name && *has);
+            if user_metric && declares && !params.contains("sizes") {
+                params.set("sizes", true);
+            }
+            (name.to_string(), params)
+        };
+        let declares =
+            |options: &[crate::registry::OptionDoc]| options.iter().any(|o| o.name == "sizes");
+        let strategies: Vec<(&str, bool)> = crate::patches::STRATEGIES
             .iter()
-            .any(|e| e.name == name && e.options.iter().any(|o| o.name == "sizes"));
-        if user_metric && declares_sizes && !params.contains("sizes") {
-            params.set("sizes", true);
-        }
-        let remesher = (name, params);
+            .map(|e| (e.name, declares(e.options)))
+            .collect();
+        let remeshers: Vec<(&str, bool)> = crate::remesh2d::REMESHERS
+            .iter()
+            .map(|e| (e.name, declares(e.options)))
+            .collect();
+        let (sname, sparams) = with_sizes(&strategies, strategy);
+        let (rname, rparams) = with_sizes(&remeshers, remesher);
+        let strategy = (sname.as_str(), sparams);
+        let remesher = (rname.as_str(), rparams);
         Ok(Stages {
             patches: crate::patches::strategy(strategy.0, strategy.1)?,
             parameterizer: crate::param::parameterizer(parameterizer.0, parameterizer.1)?,
