@@ -69,6 +69,12 @@ pub fn orient2d(a: &Point2<f64>, b: &Point2<f64>, c: &Point2<f64>) -> Sign {
 /// is *below* a counter-clockwise `abc`.) Exact.
 #[inline]
 pub fn orient3d(a: &Point3<f64>, b: &Point3<f64>, c: &Point3<f64>, d: &Point3<f64>) -> Sign {
+    // Four points with one coordinate equal lie in an axis-aligned plane: the determinant is
+    // exactly zero. Flat inputs (plates) hit this on every test, and robust would reach it
+    // only through its slowest, adaptive stage.
+    if (0..3).any(|k| a[k] == b[k] && a[k] == c[k] && a[k] == d[k]) {
+        return Sign::Zero;
+    }
     Sign::of(robust::orient3d(c3(a), c3(b), c3(c), c3(d))).reversed()
 }
 

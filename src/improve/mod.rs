@@ -45,6 +45,11 @@ pub struct SurfaceContext<'a> {
     pub feature_edges: Option<&'a HashSet<EdgeKey>>,
     /// `pinned[v]`: vertex `v` may not move (corners and feature-line vertices).
     pub pinned: &'a [bool],
+    /// The input's boundary curves, along which boundary vertices may slide.
+    pub curves: Option<&'a crate::boundary::BoundaryCurves>,
+    /// Slide boundary vertices along the input's boundary curves (not with the input's
+    /// boundary kept bit for bit).
+    pub slide_boundary: bool,
 }
 
 /// What [`finishing_passes`] did.

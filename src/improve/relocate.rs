@@ -4,6 +4,7 @@
 
 use super::geometry::{metric_optimal_point, point_triangle_distance};
 use super::SurfaceContext;
+use crate::boundary::CurvePoint;
 use crate::ids::{FaceId, VertexId};
 use crate::invariants::{candidate_embedded_local, is_degenerate_triangle, FaceGrid};
 use crate::mesh::{bbox_of, SurfaceLocation, Topology, TriMesh};
@@ -34,18 +35,31 @@ pub fn vertex_position_update(ctx: &SurfaceContext<'_>, work: &mut WorkingMesh) 
         metrics,
         settled: vec![false; work.mesh.n_vertices()],
     };
+    // Boundary neighbours (previous, next along the loop) of every boundary vertex.
+    let mut along: std::collections::HashMap<VertexId, (VertexId, VertexId)> =
+        std::collections::HashMap::new();
+    for l in topo.boundary_loops() {
+        let n = l.len();
+        for i in 0..n {
+            along.insert(l[i], (l[(i + n - 1) % n], l[(i + 1) % n]));
+        }
+    }
     let mut moved = 0;
     for _pass in 0..3 {
         for vi in 0..work.mesh.n_vertices() {
             let v = VertexId::new(vi);
             if state.settled[vi]
                 || topo.vertex_faces(v).is_empty()
-                || topo.is_boundary_vertex(v)
                 || ctx.pinned.get(vi).copied().unwrap_or(false)
             {
                 continue;
             }
-            if relocate(ctx, &topo, work, &mut state, v) {
+            let done = match along.get(&v) {
+                Some(&nbrs) if ctx.slide_boundary => slide(ctx, &topo, work, &mut state, v, nbrs),
+                Some(_) => continue,
+                None => relocate(ctx, &topo, work, &mut state, v),
+            };
+            if done {
                 moved += 1;
                 state.settled[vi] = false;
                 for u in topo.vertex_neighbors(v) {
@@ -88,9 +102,18 @@ fn fan_distance(mesh: &TriMesh, fan: &[FaceId], x: &Point3<f64>) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// Try to move `v`: the candidate positions that raise its fan's smallest quality, best
-/// first, until one passes the certificates. Returns whether `v` moved (else it is settled
-/// when no candidate scored better).
+/// A candidate position of a vertex: where, its reference location, and its point on a
+/// boundary curve when it slides along one.
+#[derive(Copy, Clone)]
+struct Candidate {
+    position: Point3<f64>,
+    location: SurfaceLocation,
+    curve: Option<CurvePoint>,
+}
+
+/// Try to move the inner vertex `v`: towards the metric-optimal point (full and half step),
+/// then the centroid of its neighbours (full, half, quarter step), projected onto the
+/// reference.
 fn relocate(
     ctx: &SurfaceContext<'_>,
     topo: &Topology,
@@ -101,13 +124,10 @@ fn relocate(
     let vi = v.idx();
     let fan = topo.vertex_faces(v);
     let nbrs = topo.vertex_neighbors(v);
-    let before = fan_quality(&work.mesh, &state.metrics, fan);
     let old = work.mesh.positions[vi];
     let c = nbrs.iter().fold(Vector3::zeros(), |acc, u| {
         acc + work.mesh.positions[u.idx()].coords
     }) / nbrs.len() as f64;
-    // Targets: the metric-optimal point (full and half step), then the centroid (full,
-    // half, quarter step); tried best first by the fan's smallest quality.
     let mut targets: Vec<Point3<f64>> = Vec::with_capacity(5);
     if let Some(opt) = metric_optimal_point(&work.mesh, fan, v, &state.metrics[vi]) {
         targets.push(opt);
@@ -116,17 +136,121 @@ fn relocate(
     for step in [1.0, 0.5, 0.25] {
         targets.push(Point3::from(old.coords + (c - old.coords) * step));
     }
-    let old_loc = work.locations[vi];
-    let old_m = state.metrics[vi];
-    let mut scored: Vec<(f64, SurfaceLocation, Point3<f64>)> = targets
+    let candidates: Vec<Candidate> = targets
         .iter()
-        .map(|target| {
-            let (loc, p) = ctx.field.project(target);
-            work.mesh.positions[vi] = p;
-            state.metrics[vi] = ctx.field.eval_at(&loc);
-            (fan_quality(&work.mesh, &state.metrics, fan), loc, p)
+        .map(|t| {
+            let (location, position) = ctx.field.project(t);
+            Candidate {
+                position,
+                location,
+                curve: None,
+            }
         })
-        .filter(|(q, _, _)| *q > before)
+        .collect();
+    try_candidates(ctx, topo, work, state, v, &candidates, &[])
+}
+
+/// Try to slide the boundary vertex `v` along its input curve, between its boundary
+/// neighbours `prev` and `next`: to where its two boundary edges have equal metric length,
+/// and half way there. Corners never slide.
+fn slide(
+    ctx: &SurfaceContext<'_>,
+    topo: &Topology,
+    work: &mut WorkingMesh,
+    state: &mut Relocation,
+    v: VertexId,
+    (prev, next): (VertexId, VertexId),
+) -> bool {
+    let Some(curves) = ctx.curves else {
+        return false;
+    };
+    let point = |u: VertexId| work.curve.get(u.idx()).copied().flatten();
+    let (Some(p), Some(pa), Some(pb)) = (point(v), point(prev), point(next)) else {
+        return false;
+    };
+    if curves.is_corner_point(&p) || pa.curve != p.curve || pb.curve != p.curve {
+        return false;
+    }
+    let l = p.curve as usize;
+    let total = curves.length(l);
+    let (sa, sv) = (curves.arc(&pa), curves.arc(&p));
+    let da = (sv - sa).rem_euclid(total);
+    let span = da + (curves.arc(&pb) - sv).rem_euclid(total);
+    if !(span > 0.0 && span < total) {
+        return false;
+    }
+    let reference = ctx.field.reference();
+    let m = state.metrics[v.idx()];
+    let (xa, xb) = (work.mesh.positions[prev.idx()], work.mesh.positions[next.idx()]);
+    let len = |x: &Point3<f64>, y: &Point3<f64>| {
+        let d = y - x;
+        d.dot(&(m * d)).max(0.0).sqrt()
+    };
+    let at = |f: f64| curves.at_arc(l, sa + f * span);
+    // Bisection for the fraction where the two boundary edges are equally long in the metric.
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        let x = curves.position(reference, &at(mid));
+        if len(&xa, &x) < len(&x, &xb) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let f_now = da / span;
+    let f_bal = 0.5 * (lo + hi);
+    let candidates: Vec<Candidate> = [f_bal, 0.5 * (f_now + f_bal)]
+        .into_iter()
+        .filter(|f| *f > 0.0 && *f < 1.0)
+        .map(|f| {
+            let cp = at(f);
+            Candidate {
+                position: curves.position(reference, &cp),
+                location: curves.location(&cp),
+                curve: Some(cp),
+            }
+        })
+        .collect();
+    // The input curve's vertices between the neighbours: the new chords must not pass
+    // farther from them than the tolerance.
+    let between: Vec<Point3<f64>> = curves
+        .vertices_between(l, sa, sa + span)
+        .map(|u| reference.positions[u.idx()])
+        .collect();
+    try_candidates(ctx, topo, work, state, v, &candidates, &between)
+}
+
+/// Move `v` to the best of `candidates` that raises its fan's smallest quality and passes the
+/// certificates (not degenerate, not flipped, locally embedded, and no watched point — its old
+/// position, the corners of the reference faces under it and its neighbours, and `extra` —
+/// farther from the fan than the tolerance unless it already was, then not farther). Returns
+/// whether `v` moved; settles it when no candidate scored better.
+fn try_candidates(
+    ctx: &SurfaceContext<'_>,
+    topo: &Topology,
+    work: &mut WorkingMesh,
+    state: &mut Relocation,
+    v: VertexId,
+    candidates: &[Candidate],
+    extra: &[Point3<f64>],
+) -> bool {
+    let vi = v.idx();
+    let fan = topo.vertex_faces(v);
+    let nbrs = topo.vertex_neighbors(v);
+    let before = fan_quality(&work.mesh, &state.metrics, fan);
+    let old = work.mesh.positions[vi];
+    let old_loc = work.locations[vi];
+    let old_curve = work.curve.get(vi).copied().flatten();
+    let old_m = state.metrics[vi];
+    let mut scored: Vec<(f64, Candidate)> = candidates
+        .iter()
+        .map(|c| {
+            work.mesh.positions[vi] = c.position;
+            state.metrics[vi] = ctx.field.eval_at(&c.location);
+            (fan_quality(&work.mesh, &state.metrics, fan), *c)
+        })
+        .filter(|(q, _)| *q > before)
         .collect();
     work.mesh.positions[vi] = old;
     state.metrics[vi] = old_m;
@@ -135,9 +259,6 @@ fn relocate(
         state.settled[vi] = true;
         return false;
     }
-    // Reference vertices under the fan (corners of the reference faces at the fan's vertices'
-    // locations) and their distance to the fan now: no move may push one of them farther than
-    // `tol` away unless it already was (then not farther).
     let reference = ctx.field.reference();
     let mut watch: Vec<Point3<f64>> = std::iter::once(v)
         .chain(nbrs.iter().copied())
@@ -145,14 +266,15 @@ fn relocate(
         .map(|r| reference.positions[r.idx()])
         .collect();
     watch.push(old);
+    watch.extend_from_slice(extra);
     let watch_before: Vec<f64> = watch
         .iter()
         .map(|x| fan_distance(&work.mesh, fan, x))
         .collect();
-    for (_, loc, p) in scored {
-        work.mesh.positions[vi] = p;
-        work.locations[vi] = loc;
-        state.metrics[vi] = ctx.field.eval_at(&loc);
+    for (_, c) in scored {
+        work.mesh.positions[vi] = c.position;
+        work.locations[vi] = c.location;
+        state.metrics[vi] = ctx.field.eval_at(&c.location);
         let tris: Vec<[Point3<f64>; 3]> = fan
             .iter()
             .map(|f| work.mesh.triangles[f.idx()].map(|u| work.mesh.positions[u.idx()]))
@@ -175,11 +297,17 @@ fn relocate(
                     state.grid.insert(f.idx(), &lo, &hi);
                 }
             }
+            if c.curve.is_some() {
+                work.curve[vi] = c.curve;
+            }
             return true;
         }
         work.mesh.positions[vi] = old;
         work.locations[vi] = old_loc;
         state.metrics[vi] = old_m;
+        if let Some(slot) = work.curve.get_mut(vi) {
+            *slot = old_curve;
+        }
     }
     false
 }

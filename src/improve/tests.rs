@@ -18,6 +18,8 @@ fn ctx<'a>(
         tol,
         feature_edges,
         pinned: &[],
+        curves: None,
+        slide_boundary: false,
     }
 }
 

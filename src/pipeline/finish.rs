@@ -28,6 +28,8 @@ pub fn improve(ctx: &RunContext<'_>, state: &mut LoopState) -> PassCounts {
         tol: passes_tolerance(ctx.plan.eps),
         feature_edges: (!state.features.edges.is_empty()).then_some(&state.features.edges),
         pinned: &state.pinned,
+        curves: Some(&ctx.curves),
+        slide_boundary: o.boundary.resample,
     };
     let counts = finishing_passes(&surface, &mut state.work, o.edge_flips, o.relocate);
     state.counters.times.certify += t0.elapsed().as_secs_f64();

@@ -252,6 +252,30 @@ impl PlanarMetricField {
     /// The triangle nearest to `p` (Euclidean distance), by a scan; used only when `p` is
     /// outside the mesh through rounding.
     fn nearest_triangle(&self, p: &Point2<f64>) -> usize {
+        // The triangles registered in the cells around p's (clamped) cell first: a point
+        // just outside the mesh has its nearest triangle there; the full scan only when those
+        // cells are empty.
+        let (cx, cy) = self.cell_of(p);
+        let mut near: Vec<u32> = Vec::new();
+        for y in cy.saturating_sub(1)..(cy + 2).min(self.ny) {
+            for x in cx.saturating_sub(1)..(cx + 2).min(self.nx) {
+                near.extend_from_slice(&self.buckets[y * self.nx + x]);
+            }
+        }
+        let dist = |f: usize| {
+            let [a, b, c] = self.triangles[f].map(|i| self.points[i as usize]);
+            [(a, b), (b, c), (c, a)]
+                .iter()
+                .map(|(u, v)| seg_dist2(p, u, v))
+                .fold(f64::INFINITY, f64::min)
+        };
+        if let Some(f) = near
+            .iter()
+            .map(|&f| f as usize)
+            .min_by(|&f, &g| dist(f).total_cmp(&dist(g)).then(f.cmp(&g)))
+        {
+            return f;
+        }
         let mut best = (f64::INFINITY, 0usize);
         for (f, t) in self.triangles.iter().enumerate() {
             let [a, b, c] = t.map(|i| self.points[i as usize]);
