@@ -181,7 +181,10 @@ fn slide(
     }
     let reference = ctx.field.reference();
     let m = state.metrics[v.idx()];
-    let (xa, xb) = (work.mesh.positions[prev.idx()], work.mesh.positions[next.idx()]);
+    let (xa, xb) = (
+        work.mesh.positions[prev.idx()],
+        work.mesh.positions[next.idx()],
+    );
     let len = |x: &Point3<f64>, y: &Point3<f64>| {
         let d = y - x;
         d.dot(&(m * d)).max(0.0).sqrt()

@@ -325,11 +325,19 @@ impl TriMesh {
     /// Mean edge length over all half-edges (each interior edge counted twice).
     pub fn mean_edge_length(&self) -> f64 {
         let mut s = 0.0;
-        for f in self.faces() {
-            let [a, b, c] = self.face_points(f);
-            s += (b - a).norm() + (c - b).norm() + (a - c).norm();
+        for l in self.face_edge_lengths() {
+            s += l[0] + l[1] + l[2];
         }
         s / (3 * self.n_faces()).max(1) as f64
+    }
+
+    /// The lengths of each face's three edges (`|p1 − p0|`, `|p2 − p1|`, `|p0 − p2|`), in face
+    /// order.
+    pub fn face_edge_lengths(&self) -> impl Iterator<Item = [f64; 3]> + '_ {
+        self.faces().map(|f| {
+            let [a, b, c] = self.face_points(f);
+            [(b - a).norm(), (c - b).norm(), (a - c).norm()]
+        })
     }
 
     /// The mesh with every face's orientation reversed.
