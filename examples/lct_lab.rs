@@ -18,7 +18,7 @@ fn main() {
     let remesher =
         conemesh::remesh2d::planar_remesher("lct", Params::parse(&opts).expect("KEY=VALUE"))
             .expect("options");
-    let corners = vec![
+    let corners = [
         Point2::new(0.0, 0.0),
         Point2::new(1.0, 0.0),
         Point2::new(1.0, 1.0),

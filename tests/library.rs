@@ -2,10 +2,11 @@
 //! to a certified mesh in file units, the same bytes as `conemesh remesh`; typed failures,
 //! warnings and the patch budget; the registries reached from the command line.
 
+use conemesh::boundary::BoundaryOptions;
 use conemesh::ids::VertexId;
 use conemesh::invariants::{
-    certify_boundary_preserved, certify_no_degenerate_faces, certify_no_self_intersections,
-    certify_same_topology,
+    certify_boundary_on_curves, certify_boundary_preserved, certify_no_degenerate_faces,
+    certify_no_self_intersections, certify_same_topology,
 };
 use conemesh::mesh::{generators, TriMesh};
 use conemesh::param::{ParamError, Parameterization, Parameterizer};
@@ -83,7 +84,7 @@ fn the_remesher_returns_a_certified_file_unit_mesh_identical_to_the_cli() {
 }
 
 /// A flat disk with a boundary, a constant user metric, unreferenced vertices in the file:
-/// the boundary is kept bit for bit, the metric follows the compaction, errors name the
+/// the boundary is resampled on the input's curve (kept bit for bit when asked), the metric follows the compaction, errors name the
 /// problem.
 #[test]
 fn a_user_metric_through_the_library() {
@@ -110,7 +111,27 @@ fn a_user_metric_through_the_library() {
         "unreferenced vertices dropped"
     );
     assert_eq!(out.input_metric.as_ref().map(Vec::len), Some(n - 2));
-    certify_boundary_preserved(&out.input, &out.mesh).expect("boundary kept");
+    let topo = conemesh::mesh::Topology::build(&out.mesh);
+    certify_boundary_on_curves(
+        &out.unit.curves,
+        &out.input,
+        &out.mesh,
+        &topo,
+        &out.unit.curve,
+    )
+    .expect("boundary resampled on the input's boundary curve");
+    // With resampling off the input's boundary vertices stay bit for bit.
+    let kept = Remesher::new(RemeshOptions {
+        target: conemesh::pipeline::TargetLength::Absolute(1.0),
+        boundary: BoundaryOptions {
+            resample: false,
+            ..BoundaryOptions::default()
+        },
+        ..RemeshOptions::default()
+    })
+    .run_with_metric(&disk, &metric)
+    .expect("remeshes with the boundary kept");
+    certify_boundary_preserved(&kept.input, &kept.mesh).expect("boundary kept");
     // Edges near 0.3 in file units: about (area / (0.433·0.09)) faces.
     let expected = std::f64::consts::PI * 9.0 / (3f64.sqrt() / 4.0 * 0.09);
     let f = out.mesh.n_faces() as f64;

@@ -75,7 +75,8 @@ pub struct RemeshArgs {
     /// Write quality histograms (PNG) into this directory.
     #[arg(long)]
     pub plots: Option<PathBuf>,
-    /// Write the metric at the output vertices (Medit .sol, file units).
+    /// Write the metric at the output vertices (Medit .sol, file units): the metric the mesh
+    /// was built to, a user's tensors restricted to the surface's tangent plane.
     #[arg(long)]
     pub write_metric: Option<PathBuf>,
     /// Directory for offending patches when a certificate fails (default: the output's).

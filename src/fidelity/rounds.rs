@@ -203,21 +203,6 @@ pub fn refine<E>(
             triangles: &out.planar.triangles,
         };
         let deviating = deviations(setup.field, setup.normals, &patch, eps);
-        if std::env::var("DBG_FID").is_ok() {
-            let worst = deviating.iter().map(|d| d.1).fold(0.0, f64::max);
-            eprintln!(
-                "round {rounds}: {} deviating (eps {eps}), worst {worst}",
-                deviating.len()
-            );
-            for &(t, d) in deviating.iter().take(5) {
-                let tri = out.planar.triangles[t];
-                eprintln!(
-                    "  t{t} d {d} fixed {:?} pos {:?}",
-                    tri.map(|i| fixed[i as usize]),
-                    tri.map(|i| lifted[i as usize])
-                );
-            }
-        }
         let scaled = match deviating.is_empty() {
             true => 0,
             false => scale_metric(

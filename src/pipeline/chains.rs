@@ -140,25 +140,6 @@ pub fn patch_domain(
         .filter(|v| !on_loop.contains(v))
         .collect();
     let interior_uv: Vec<Point2<f64>> = interior.iter().map(|v| uv[v.idx()]).collect();
-    if std::env::var("DBG_CHAIN").is_ok() {
-        let old: Vec<Point2<f64>> = b.iter().map(|v| uv[v.idx()]).collect();
-        eprintln!(
-            "chains {} old loop {} new loop {}",
-            chains.len(),
-            old.len(),
-            loop_uv.len()
-        );
-        let f = format!("/tmp/chain-{}.txt", loop_uv.len());
-        let mut txt = String::new();
-        for (q, p) in loop_uv.iter().zip(&loop_pos) {
-            txt += &format!("N {} {} {} {} {}\n", q.x, q.y, p.x, p.y, p.z);
-        }
-        for (v, q) in b.iter().zip(&old) {
-            let p = disk.mesh.positions[v.idx()];
-            txt += &format!("O {} {} {} {} {}\n", q.x, q.y, p.x, p.y, p.z);
-        }
-        let _ = std::fs::write(f, txt);
-    }
     let Ok((domain, kept)) = triangulate_polygon_with(&loop_uv, &interior_uv) else {
         return unchanged();
     };

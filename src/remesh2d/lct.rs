@@ -167,7 +167,7 @@ fn from_boundary(domain: &PlanarDomain, metric: &dyn Metric2d, spacing: f64) -> 
     let (cdt, inside) = super::triangulate_polygon_with(&loop_points, &points).ok()?;
     let mut origin: Vec<Option<u32>> = domain.boundary.iter().map(|&b| Some(b)).collect();
     origin.extend(inside.iter().map(|&i| Some(kept[i])));
-    (origin.len() == cdt.points.len()).then(|| PlanarMesh {
+    (origin.len() == cdt.points.len()).then_some(PlanarMesh {
         points: cdt.points,
         triangles: cdt.triangles,
         origin,
@@ -182,7 +182,7 @@ fn spaced(
     candidates: &[u32],
     spacing: f64,
 ) -> Vec<u32> {
-    if candidates.is_empty() || !(spacing > 0.0) {
+    if candidates.is_empty() || spacing.is_nan() || spacing <= 0.0 {
         return Vec::new();
     }
     let tensor = |i: u32| clamp_spd(&metric.metric(&domain.points[i as usize]));

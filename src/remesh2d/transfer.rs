@@ -242,6 +242,7 @@ fn principal_fit(
 mod tests {
     use super::*;
     use crate::mesh::generators;
+    use nalgebra::Vector3;
 
     fn flat_disk() -> (TriMesh, Vec<Point2<f64>>) {
         let m = generators::disk(1.0, 4, 12);
