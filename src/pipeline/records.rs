@@ -59,7 +59,10 @@ pub struct Certificate {
     pub oriented: usize,
     /// Genus, components and boundary loops equal the input's after the patch.
     pub same_topology: usize,
-    /// The input's boundary vertices and edges unchanged after the patch.
+    /// The boundary certificate held after the patch: every boundary vertex on the input's
+    /// boundary curves, corners kept (resampling, the default), or the input's boundary vertices
+    /// and edges unchanged (`BoundaryOptions::resample` off). The name predates resampling and
+    /// stays so that reports keep their keys.
     pub boundary_preserved: usize,
     /// No new face degenerate (exact) after the patch.
     pub no_degenerate: usize,
