@@ -348,22 +348,7 @@ mod tests {
 
     /// A flat square plate, 4×4 quads of the unit square.
     fn plate() -> TriMesh {
-        let n = 4;
-        let mut pos = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                pos.push(Point3::new(i as f64 / n as f64, j as f64 / n as f64, 0.0));
-            }
-        }
-        let mut tris = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                let a = j * (n + 1) + i;
-                tris.push([a, a + 1, a + n + 2]);
-                tris.push([a, a + n + 2, a + n + 1]);
-            }
-        }
-        TriMesh::from_indices(pos, &tris).expect("plate")
+        generators::plate(1.0, 4)
     }
 
     #[test]

@@ -10,23 +10,9 @@ use conemesh::mesh::{generators, Topology, TriMesh};
 use conemesh::pipeline::{RemeshOptions, Remesher, TargetLength};
 use nalgebra::{Matrix3, Point3};
 
-/// The unit square plate, `n × n` quads split along one diagonal.
+/// The unit square plate, `n × n` grid cells.
 fn plate(n: usize) -> TriMesh {
-    let mut pos = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            pos.push(Point3::new(i as f64 / n as f64, j as f64 / n as f64, 0.0));
-        }
-    }
-    let mut tris = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let a = j * (n + 1) + i;
-            tris.push([a, a + 1, a + n + 2]);
-            tris.push([a, a + n + 2, a + n + 1]);
-        }
-    }
-    TriMesh::from_indices(pos, &tris).expect("plate")
+    generators::plate(1.0, n)
 }
 
 /// Sizes `hx` along x and `hy` along y, SPD in 3D (the normal size the smaller), as a user's

@@ -242,11 +242,7 @@ pub fn patch_vertex_factors(field: &MetricField, scale: &[f64], patch: &TriMesh)
     }
     high.sort_unstable();
     high.dedup();
-    let tris: Vec<[u32; 3]> = patch
-        .triangles
-        .iter()
-        .map(|t| [t[0].0, t[1].0, t[2].0])
-        .collect();
+    let tris: Vec<[u32; 3]> = patch.index_triangles();
     let Some(bvh) = parry_trimesh(&patch.positions, tris) else {
         return out;
     };

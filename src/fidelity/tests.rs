@@ -86,11 +86,7 @@ fn deviations_see_a_cut_off_apex_and_nothing_on_the_reference_itself() {
     let fixed: Vec<bool> = (0..unit.n_vertices())
         .map(|v| boundary.contains(&VertexId::new(v)))
         .collect();
-    let tris: Vec<[u32; 3]> = unit
-        .triangles
-        .iter()
-        .map(|t| [t[0].0, t[1].0, t[2].0])
-        .collect();
+    let tris: Vec<[u32; 3]> = unit.index_triangles();
     let same = deviations(
         &f,
         &normals,

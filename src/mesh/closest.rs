@@ -18,11 +18,7 @@ impl SurfaceProjector {
     /// Index the triangles of `mesh`. A mesh without faces gives a projector that finds
     /// nothing.
     pub fn new(mesh: &TriMesh) -> Self {
-        let indices: Vec<[u32; 3]> = mesh
-            .triangles
-            .iter()
-            .map(|t| [t[0].0, t[1].0, t[2].0])
-            .collect();
+        let indices: Vec<[u32; 3]> = mesh.index_triangles();
         SurfaceProjector {
             bvh: parry_trimesh(&mesh.positions, indices),
         }

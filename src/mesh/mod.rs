@@ -224,6 +224,14 @@ impl TriMesh {
         self.triangles[f.idx()]
     }
 
+    /// The faces as raw index triples (what parry, spade and the planar domains take).
+    pub fn index_triangles(&self) -> Vec<[u32; 3]> {
+        self.triangles
+            .iter()
+            .map(|t| [t[0].0, t[1].0, t[2].0])
+            .collect()
+    }
+
     /// The three corner positions of a face.
     #[inline]
     pub fn face_points(&self, f: FaceId) -> [Point3<f64>; 3] {

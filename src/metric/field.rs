@@ -157,11 +157,7 @@ impl MetricField {
             .collect();
         let bvh = ParryTriMesh::new(
             reference.positions.iter().map(to_parry).collect(),
-            reference
-                .triangles
-                .iter()
-                .map(|t| [t[0].0, t[1].0, t[2].0])
-                .collect(),
+            reference.index_triangles(),
         )
         .map_err(|e| MetricError::Bvh {
             detail: e.to_string(),

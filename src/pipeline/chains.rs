@@ -51,12 +51,7 @@ pub fn patch_domain(
     let unchanged = || PatchDomain {
         domain: PlanarDomain {
             points: uv.to_vec(),
-            triangles: disk
-                .mesh
-                .triangles
-                .iter()
-                .map(|t| [t[0].0, t[1].0, t[2].0])
-                .collect(),
+            triangles: disk.mesh.index_triangles(),
             boundary: disk.boundary.iter().map(|v| v.0).collect(),
             constrained_edges: Vec::new(),
         },

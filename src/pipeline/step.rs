@@ -359,12 +359,7 @@ impl Transferred {
         };
         Ok(Transferred {
             uv: uv.to_vec(),
-            triangles: disk
-                .mesh
-                .triangles
-                .iter()
-                .map(|t| [t[0].0, t[1].0, t[2].0])
-                .collect(),
+            triangles: disk.mesh.index_triangles(),
             metrics,
             corners,
         })
