@@ -8,7 +8,7 @@ use conemesh::invariants::{
 };
 use conemesh::mesh::{generators, Topology, TriMesh};
 use conemesh::pipeline::{RemeshOptions, Remesher, TargetLength};
-use nalgebra::{Matrix3, Point3};
+use nalgebra::Matrix3;
 
 /// The unit square plate, `n × n` grid cells.
 fn plate(n: usize) -> TriMesh {
