@@ -137,6 +137,9 @@ pub struct RoundOutput {
     pub new_uv: Vec<nalgebra::Point2<f64>>,
     /// The certified planar remesh.
     pub planar: PlanarMesh,
+    /// Which of its vertices are kept domain-boundary (or constrained) vertices: those that no
+    /// round can change. An interior vertex the remesher left in place is not one of them.
+    pub kept: Vec<bool>,
     /// The planar metric field (on the initial 2D mesh) of this round.
     pub field: PlanarMetricField,
     /// The lifted candidate.
@@ -195,11 +198,10 @@ pub fn refine<E>(
             return Ok(finish(out, &metrics));
         }
         let t0 = Instant::now();
-        let fixed: Vec<bool> = out.planar.origin.iter().map(Option::is_some).collect();
         let lifted = &out.lifted;
         let patch = LiftedPatch {
             positions: lifted,
-            fixed: &fixed,
+            fixed: &out.kept,
             triangles: &out.planar.triangles,
         };
         let deviating = deviations(setup.field, setup.normals, &patch, eps);

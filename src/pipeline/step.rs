@@ -17,10 +17,12 @@ use crate::fidelity::{self, PatchVertices, Refined, RoundOutput, RoundsSetup, Ve
 use crate::ids::{FaceId, PatchId};
 use crate::invariants::{self, InvariantError};
 use crate::lift::{lift, DomainVertex, PatchFrame};
-use crate::mesh::Topology;
+use crate::mesh::{PlanarDomain, Topology};
 use crate::param::DistortionReport;
 use crate::patches::{extract_patch, interior_corner, interior_feature, Patch, PatchMesh};
-use crate::remesh2d::{pullback_corners, transfer_metric, PlanarMetricField, TransferMethod};
+use crate::remesh2d::{
+    pullback_corners, transfer_metric, PlanarMesh, PlanarMetricField, TransferMethod,
+};
 use crate::stitch::{Replacement, WorkingMesh};
 use nalgebra::{Matrix2, Matrix3};
 use std::time::Instant;
@@ -455,10 +457,12 @@ fn remesh_and_lift(
             .map_err(|e| AttemptFailure::at(Stage::MappingBack)(e.into()))?;
             counters.times.lift += t0.elapsed().as_secs_f64();
             let (lifted, new_uv) = round_vertices(&planar, domain, &replacement);
+            let kept = kept_vertices(&domain.domain, &planar);
             Ok(RoundOutput {
                 lifted,
                 new_uv,
                 planar,
+                kept,
                 field: planar_field,
                 replacement,
             })
@@ -495,4 +499,57 @@ fn round_vertices(
         })
         .collect();
     (lifted, new_uv)
+}
+
+/// The planar vertices that are kept boundary or constrained vertices of `domain` (what no
+/// remesh of it can move).
+fn kept_vertices(domain: &PlanarDomain, planar: &PlanarMesh) -> Vec<bool> {
+    let mut kept = vec![false; domain.points.len()];
+    for &b in domain
+        .boundary
+        .iter()
+        .chain(domain.constrained_edges.iter().flatten())
+    {
+        kept[b as usize] = true;
+    }
+    planar
+        .origin
+        .iter()
+        .map(|o| o.is_some_and(|i| kept[i as usize]))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point2;
+
+    #[test]
+    fn only_boundary_and_constrained_vertices_are_kept() {
+        // A square with two interior vertices, one of them on a constrained chord from corner 0.
+        let domain = PlanarDomain {
+            points: vec![
+                Point2::new(0.0, 0.0),
+                Point2::new(1.0, 0.0),
+                Point2::new(1.0, 1.0),
+                Point2::new(0.0, 1.0),
+                Point2::new(0.5, 0.5),
+                Point2::new(0.7, 0.3),
+            ],
+            triangles: Vec::new(),
+            boundary: vec![0, 1, 2, 3],
+            constrained_edges: vec![[0, 4]],
+        };
+        // The remesh keeps every input vertex (an interior one the remesher did not move keeps
+        // its origin too) and adds one.
+        let planar = PlanarMesh {
+            points: Vec::new(),
+            triangles: Vec::new(),
+            origin: vec![Some(3), Some(5), Some(4), None, Some(0), Some(1), Some(2)],
+        };
+        assert_eq!(
+            kept_vertices(&domain, &planar),
+            vec![true, false, true, false, true, true, true]
+        );
+    }
 }

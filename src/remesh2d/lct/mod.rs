@@ -24,6 +24,7 @@
 use super::{clamp_spd, Metric2d, PlanarDomain, PlanarMesh, PlanarRemesher, Remesh2dError};
 use crate::invariants::certify_planar;
 use nalgebra::{Matrix2, Point2};
+use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
 use std::collections::{HashMap, HashSet};
 use work::Work;
@@ -148,11 +149,17 @@ impl PlanarRemesher for Lct {
 
 /// The start of the rounds: the constrained Delaunay triangulation of the domain's boundary
 /// polygon and of those of its interior vertices that are at least `spacing` apart in the
-/// metric from the boundary and from each other (taken in id order), as a remesh of `domain`;
-/// `None` when spade cannot triangulate it. The result does not inherit the input's
-/// connectivity (a regular input grid that is anisotropic in the metric is a fixed point of
-/// split, collapse, flip and smoothing), while a fine input gives a well-spaced start.
-fn from_boundary(domain: &PlanarDomain, metric: &dyn Metric2d, spacing: f64) -> Option<PlanarMesh> {
+/// metric from the boundary and from each other (taken in a seeded random order), as a remesh
+/// of `domain`; `None` when spade cannot triangulate it. The result inherits neither the input's
+/// connectivity nor its lattice: in id order, a regular grid that is anisotropic in the metric
+/// leaves a regular sub-lattice of non-equilateral triangles, a fixed point of split, collapse,
+/// flip and smoothing (paper-notes.md, "LCT remeshing").
+fn from_boundary(
+    domain: &PlanarDomain,
+    metric: &dyn Metric2d,
+    spacing: f64,
+    rng: &mut ChaCha8Rng,
+) -> Option<PlanarMesh> {
     let loop_points: Vec<Point2<f64>> = domain
         .boundary
         .iter()
@@ -162,9 +169,10 @@ fn from_boundary(domain: &PlanarDomain, metric: &dyn Metric2d, spacing: f64) -> 
     for &b in &domain.boundary {
         on_boundary[b as usize] = true;
     }
-    let interior: Vec<u32> = (0..domain.points.len() as u32)
+    let mut interior: Vec<u32> = (0..domain.points.len() as u32)
         .filter(|&i| !on_boundary[i as usize])
         .collect();
+    interior.shuffle(rng);
     let kept = spaced(domain, metric, &interior, spacing);
     let points: Vec<Point2<f64>> = kept.iter().map(|&i| domain.points[i as usize]).collect();
     let (cdt, inside) = super::triangulate_polygon_with(&loop_points, &points).ok()?;
@@ -178,7 +186,7 @@ fn from_boundary(domain: &PlanarDomain, metric: &dyn Metric2d, spacing: f64) -> 
 }
 
 /// The candidates (ids of `domain`'s points) at least `spacing` from the boundary vertices and
-/// from each other in the metric (mean of the two points' tensors), greedily in order.
+/// from each other in the metric (mean of the two points' tensors), greedily in the given order.
 fn spaced(
     domain: &PlanarDomain,
     metric: &dyn Metric2d,
@@ -279,7 +287,7 @@ pub fn remesh_planar(
         locked.insert((a.min(b), a.max(b)));
     }
     let mut mesh = match options.rebuild && domain.constrained_edges.is_empty() {
-        true => from_boundary(domain, metric, target_length * options.start_spacing)
+        true => from_boundary(domain, metric, target_length * options.start_spacing, rng)
             .unwrap_or_else(|| identity(domain)),
         false => identity(domain),
     };
