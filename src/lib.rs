@@ -13,7 +13,8 @@
 //! - [`lift`], [`stitch`]: Sec. 3.3 "Mapping back", replacing a patch.
 //! - [`fidelity`]: the distance control of a patch (ours).
 //! - [`pipeline`]: Algorithm 1, and [`pipeline::Remesher`], the whole job from file units.
-//! - [`improve`]: Sec. 3.4, connectivity and vertex position updates on the surface.
+//! - [`improve`]: Sec. 3.4, connectivity and vertex position updates on the surface, and
+//!   Algorithm 2's planar updates (Eq. 5-6).
 //! - [`quality`], [`report`]: Sec. 4.1, the yardstick; JSON and plots.
 //! - [`registry`], [`contract`]: the extension points' tables and their contract checks.
 //! - [`boundary`]: the input's boundary curves the output's boundary lies on (ours).

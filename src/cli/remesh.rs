@@ -129,6 +129,15 @@ pub struct RemeshArgs {
     /// and stay.
     #[arg(long, default_value_t = conemesh::boundary::BoundaryOptions::default().corner_angle)]
     pub boundary_corner_angle: f64,
+    /// Run Algorithm 2 (minimum-angle improvement, Sec. 3.4) after the loop: cone patches
+    /// around the faces whose metric quality is below `--improve-q`, improved in the plane by
+    /// the vertex position and connectivity updates of Eq. 5-6. Off by default while it is
+    /// measured.
+    #[arg(long)]
+    pub improve: bool,
+    /// With `--improve`: the quality below which a face is improved.
+    #[arg(long, default_value_t = conemesh::pipeline::ImproveOptions::default().q_threshold)]
+    pub improve_q: f64,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -290,6 +299,11 @@ fn options(args: &RemeshArgs) -> RemeshOptions {
             Coarse::Auto => CoarseInput::Auto,
             Coarse::On => CoarseInput::On,
             Coarse::Off => CoarseInput::Off,
+        },
+        improve: conemesh::pipeline::ImproveOptions {
+            enabled: args.improve,
+            q_threshold: args.improve_q,
+            ..conemesh::pipeline::ImproveOptions::default()
         },
         ..RemeshOptions::default()
     }

@@ -9,16 +9,20 @@
 //! their vertices and edges were fixed patch-boundary elements while the patches were
 //! remeshed. Every change is a candidate certified like a patch's new faces (not degenerate,
 //! not flipped, locally embedded) and keeps the surface within the distance tolerance.
-//! Where this differs from the paper's Algorithm 2 (which re-parameterizes a cone patch
-//! around each bad triangle): paper-notes.md, Sec. 3.4.
+//! Algorithm 2 proper, which re-parameterizes a cone patch around each bad triangle and runs
+//! the two updates in its plane on the energy of Eq. 5-6, is `eq5.rs` (the planar updates, a
+//! [`crate::remesh2d::PlanarRemesher`]) driven by `pipeline/algorithm2.rs` (opt-in,
+//! `--improve`); how the two differ and what each measured: paper-notes.md, Sec. 3.4.
 //!
 //! Files: `flips.rs` (connectivity update), `relocate.rs` (vertex position update),
-//! `geometry.rs` (the helpers they share).
+//! `geometry.rs` (the helpers they share), `eq5.rs` (Algorithm 2's planar updates).
 
+pub mod eq5;
 mod flips;
 mod geometry;
 mod relocate;
 
+pub use eq5::{Eq5Improver, Eq5Options, FlipRule, Target};
 pub use flips::connectivity_update;
 pub use relocate::vertex_position_update;
 

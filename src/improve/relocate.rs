@@ -14,7 +14,7 @@ use nalgebra::{Matrix3, Point3, Vector3};
 
 /// The vertex position update (Sec. 3.4) on the surface, after the loop: every vertex off the
 /// input boundary is moved towards the point that makes its faces equilateral in the metric
-/// (full or half step, [`super::geometry`]'s metric-optimal point) or towards the centroid of
+/// (full or half step, the metric-optimal point of `geometry.rs`) or towards the centroid of
 /// its neighbours (full, half or quarter step), best first, and projected
 /// onto the reference (its location follows), when the smallest metric quality of its faces
 /// rises, its new faces pass the candidate certificates (not degenerate, not flipped, locally

@@ -59,7 +59,7 @@ pub fn patch_domain(
         positions: disk.mesh.positions.clone(),
         chains: 0,
     };
-    if !ctx.plan.options.boundary.resample || ctx.curves.is_empty() {
+    if !ctx.plan.options.boundary.resample || ctx.improving || ctx.curves.is_empty() {
         return unchanged();
     }
     let sampler = Sampler {

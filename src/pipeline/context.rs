@@ -47,6 +47,8 @@ pub struct RunContext<'a> {
     pub corners: Vec<bool>,
     /// The input's boundary curves, with their corners.
     pub curves: BoundaryCurves,
+    /// Algorithm 2 runs (its patches keep their boundary chains as they are).
+    pub improving: bool,
 }
 
 impl<'a> RunContext<'a> {
@@ -87,6 +89,27 @@ impl<'a> RunContext<'a> {
             input_boundary: invariants::boundary_edges(&reference_topology),
             reference_topology,
             corners,
+            improving: false,
+        }
+    }
+
+    /// The same run with other stages for Algorithm 2 (whose patches keep their boundary
+    /// chains as they are).
+    pub fn for_improvement<'b>(&'b self, stages: &'b Stages) -> RunContext<'b> {
+        RunContext {
+            quality_field: self.quality_field,
+            plan: self.plan,
+            stages,
+            flip_test: FlipTest::new(self.quality_field.reference()),
+            ref_normals: self.ref_normals.clone(),
+            input_pairs: self.input_pairs,
+            embedded_input: self.embedded_input,
+            reference_topology: self.reference_topology.clone(),
+            signature: self.signature.clone(),
+            input_boundary: self.input_boundary.clone(),
+            corners: self.corners.clone(),
+            curves: self.curves.clone(),
+            improving: true,
         }
     }
 
@@ -147,6 +170,8 @@ pub struct LoopState {
     pub records: Vec<PatchRecord>,
     /// What the retry ladder did.
     pub fallbacks: Fallbacks,
+    /// What Algorithm 2 did, when it ran.
+    pub improvement: Option<super::records::ImprovementReport>,
 }
 
 /// Per-stage times and certificate counts of a run.
@@ -201,6 +226,7 @@ impl LoopState {
             counters: Counters::default(),
             records: Vec::new(),
             fallbacks: Fallbacks::default(),
+            improvement: None,
             work,
             topo,
             features,

@@ -256,6 +256,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -
         &out_topo,
     );
     let report = RemeshReport {
+        improvement: state.improvement,
         seams,
         sizes,
         boundary_distance,

@@ -12,6 +12,7 @@
 //!     stitch P' into the working mesh, mark its faces processed     // manifold, oriented,
 //!                                                                   // same topology, boundary
 //! connectivity and vertex position updates on the surface          // Sec. 3.4
+//! Algorithm 2 around the faces of low quality (opt-in)              // algorithm2.rs
 //! at the end: the whole mesh again, and no self-intersections (exact)
 //! ```
 //!
@@ -22,9 +23,10 @@
 //! Files: `options.rs` (options and stages), `sizing.rs` (the [`Plan`] resolved before the
 //! loop), `context.rs` (what a run reads and the loop's state), `step.rs` (one patch with its
 //! retry ladder), `replace.rs` (stitching and the per-patch certificates), `finish.rs` (after
-//! the loop), `records.rs` (report types), `error.rs`, `debug.rs` (offending patches written
-//! out), `remesher.rs` (the whole job).
+//! the loop), `algorithm2.rs` (minimum-angle improvement), `records.rs` (report types),
+//! `error.rs`, `debug.rs` (offending patches written out), `remesher.rs` (the whole job).
 
+mod algorithm2;
 mod chains;
 mod context;
 mod debug;
@@ -38,10 +40,10 @@ mod sizing;
 mod step;
 
 pub use error::{PipelineError, Stage, StageError};
-pub use options::{CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO};
+pub use options::{CoarseInput, ImproveOptions, RemeshOptions, Stages, TargetLength, COARSE_RATIO};
 pub use records::{
-    Certificate, FailedAttempt, Fallbacks, PatchRecord, Progress, RemeshReport, RemeshResult,
-    StageTimes, Warning,
+    AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, PatchRecord, Progress,
+    RemeshReport, RemeshResult, StageTimes, Warning,
 };
 pub use remesher::{Remeshed, Remesher};
 pub use sizing::{coarse_input_estimate, expected_faces, Plan, MAX_EXPECTED_FACES};
@@ -76,6 +78,7 @@ pub fn remesh(
         on_progress(state.progress(&ctx));
     }
     let passes = finish::improve(&ctx, &mut state); // Sec. 3.4, on the surface
+    algorithm2::run(&ctx, &mut state, &mut rng)?; // Algorithm 2 (off by default)
     finish::certify_output(&ctx, &mut state)?;
     Ok(finish::into_result(&ctx, state, passes))
 }

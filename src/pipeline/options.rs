@@ -71,6 +71,8 @@ pub struct RemeshOptions {
     /// The input's boundary (ours, [`crate::boundary`]): resampled to the metric on the input's
     /// boundary curves, corners kept (default), or kept vertex for vertex.
     pub boundary: BoundaryOptions,
+    /// The minimum-angle improvement (Algorithm 2, Sec. 3.4) after the loop.
+    pub improve: ImproveOptions,
     /// Whether to run the coarse-input profile ([`RemeshOptions::coarse_profile`]): `Auto`
     /// (default) runs it when the distance tolerance rather than the metric sets the output's
     /// size: the a-priori fidelity scaling multiplies the expected face count
@@ -115,6 +117,38 @@ impl Default for RemeshOptions {
             coarse_input: CoarseInput::Auto,
             boundary: BoundaryOptions::default(),
             sizes: SizeOptions::default(),
+            improve: ImproveOptions::default(),
+        }
+    }
+}
+
+/// Options of Algorithm 2 (Sec. 3.4), with their defaults.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ImproveOptions {
+    /// Run it (default `false` while its measurements are open, paper-notes.md Sec. 3.4).
+    pub enabled: bool,
+    /// A face whose metric quality q is below this is improved (default 0.5).
+    pub q_threshold: f64,
+    /// Passes over the faces below the threshold (default 3); a pass runs only while the
+    /// previous one strictly lowered their count.
+    pub passes: usize,
+    /// Rings of faces around a bad face that its patch takes (default 2).
+    pub rings: usize,
+    /// At most this many patches over all passes (default: no bound beyond the passes).
+    pub max_patches: Option<usize>,
+    /// The planar updates (Eq. 5-6).
+    pub planar: crate::improve::Eq5Options,
+}
+
+impl Default for ImproveOptions {
+    fn default() -> Self {
+        ImproveOptions {
+            enabled: false,
+            q_threshold: 0.5,
+            passes: 3,
+            rings: 2,
+            max_patches: None,
+            planar: crate::improve::Eq5Options::default(),
         }
     }
 }

@@ -259,6 +259,50 @@ pub struct FaceSummary {
 /// boundary (an edge between faces of two patches, or of a patch and a kept input face)
 /// against the rest.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct AngleSummary {
+    /// Faces.
+    pub faces: usize,
+    /// Smallest metric quality.
+    pub q_min: f64,
+    /// Mean metric quality.
+    pub q_avg: f64,
+    /// Smallest angle (degrees).
+    pub theta_min: f64,
+    /// Mean of each face's smallest angle (degrees).
+    pub theta_avg: f64,
+    /// Faces whose smallest angle is below 10°.
+    pub below_10: usize,
+    /// Below 20°.
+    pub below_20: usize,
+    /// Below 25°.
+    pub below_25: usize,
+    /// Below 30°.
+    pub below_30: usize,
+}
+
+/// What Algorithm 2 (minimum-angle improvement, Sec. 3.4) did: the Table-1 row before and
+/// after (in the unscaled metric), its passes and patches, and its time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ImprovementReport {
+    /// Before the step.
+    pub before: AngleSummary,
+    /// After it.
+    pub after: AngleSummary,
+    /// Passes over the faces below the threshold.
+    pub passes: usize,
+    /// Patches tried.
+    pub patches: usize,
+    /// Patches whose candidate was refused because its smallest quality on the surface was
+    /// not above that of the faces it would replace (kept as they were).
+    pub rejected: usize,
+    /// `ImproveOptions::max_patches` ran out.
+    pub budget_exhausted: bool,
+    /// Wall time of the step.
+    pub seconds: f64,
+}
+
+/// The faces touching a patch seam against the rest (see [`RemeshReport::seams`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct SeamQuality {
     /// Faces with an edge on a seam.
     pub seam: FaceSummary,
@@ -288,6 +332,8 @@ pub struct Sizes {
 pub struct RemeshReport {
     /// Options used (after the coarse-input profile, when it ran).
     pub options: RemeshOptions,
+    /// Algorithm 2, when it ran.
+    pub improvement: Option<ImprovementReport>,
     /// Strategy / parameterizer / remesher names.
     pub stages: [String; 3],
     /// Mean metric edge length of the input (L_avg).

@@ -6,7 +6,7 @@ mod domain;
 mod field;
 mod lct;
 mod registry;
-mod stats;
+pub(crate) mod stats;
 mod transfer;
 
 pub use demo::{demo_cases, run_demo_case, DemoDomain, DemoMetric};
