@@ -138,6 +138,9 @@ pub struct RemeshArgs {
     /// With `--improve`: the quality below which a face is improved.
     #[arg(long, default_value_t = conemesh::pipeline::ImproveOptions::default().q_threshold)]
     pub improve_q: f64,
+    /// With `--improve`: rings of faces around a bad face that its patch takes.
+    #[arg(long, default_value_t = conemesh::pipeline::ImproveOptions::default().rings)]
+    pub improve_rings: usize,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -303,6 +306,7 @@ fn options(args: &RemeshArgs) -> RemeshOptions {
         improve: conemesh::pipeline::ImproveOptions {
             enabled: args.improve,
             q_threshold: args.improve_q,
+            rings: args.improve_rings,
             ..conemesh::pipeline::ImproveOptions::default()
         },
         ..RemeshOptions::default()
