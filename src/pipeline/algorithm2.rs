@@ -15,7 +15,8 @@
 //! resampled. Every replaced patch is certified as in Algorithm 1. Termination: within a pass
 //! every patch marks at least one unprocessed face processed (Algorithm 1's argument); a
 //! further pass runs only when the previous one strictly lowered the count of faces below the
-//! threshold, and there are at most `passes` of them.
+//! threshold, and there are at most `passes` of them. Each pass takes one ring more around the
+//! bad faces than the last.
 
 use super::context::{LoopState, RunContext};
 use super::error::PipelineError;
@@ -42,19 +43,6 @@ pub fn run(
         return Ok(());
     }
     let t0 = Instant::now();
-    let stages = Stages {
-        patches: Box::new(ConePatches {
-            options: ConeOptions {
-                expand_rings: o.rings,
-                ..ConeOptions::default()
-            },
-        }),
-        parameterizer: Box::new(SymmetricDirichlet::default()),
-        remesher: Box::new(Eq5Improver {
-            options: o.planar.clone(),
-        }),
-    };
-    let ictx = ctx.for_improvement(&stages);
     let before = summary(&qualities(ctx, state));
     let mut bad_before = usize::MAX;
     let (mut passes, mut patches, mut rejected, mut budget_exhausted) = (0, 0, 0, false);
@@ -66,6 +54,10 @@ pub fn run(
             break;
         }
         bad_before = n_bad;
+        // Each pass reaches one ring farther: the faces still bad after a pass are those whose
+        // patch was too small to move their vertices (they sat on its boundary).
+        let stages = stages_for(o, o.rings + passes);
+        let ictx = ctx.for_improvement(&stages);
         passes += 1;
         state.work.processed = bad.iter().map(|b| !b).collect();
         while state.work.unprocessed() > 0 {
@@ -103,6 +95,22 @@ pub fn run(
         seconds: t0.elapsed().as_secs_f64(),
     });
     Ok(())
+}
+
+/// Algorithm 2's stages: cone patches expanded by `rings` rings, SD, the planar updates.
+fn stages_for(o: &super::options::ImproveOptions, rings: usize) -> Stages {
+    Stages {
+        patches: Box::new(ConePatches {
+            options: ConeOptions {
+                expand_rings: rings,
+                ..ConeOptions::default()
+            },
+        }),
+        parameterizer: Box::new(SymmetricDirichlet::default()),
+        remesher: Box::new(Eq5Improver {
+            options: o.planar.clone(),
+        }),
+    }
 }
 
 /// The candidate is better at the bottom than the faces it replaces: neither its smallest

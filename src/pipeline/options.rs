@@ -132,7 +132,8 @@ pub struct ImproveOptions {
     /// Passes over the faces below the threshold (default 3); a pass runs only while the
     /// previous one strictly lowered their count.
     pub passes: usize,
-    /// Rings of faces around a bad face that its patch takes (default 2).
+    /// Rings of faces around a bad face that its patch takes in the first pass, one more in
+    /// each further pass (default 2).
     pub rings: usize,
     /// At most this many patches over all passes (default: no bound beyond the passes).
     pub max_patches: Option<usize>,
