@@ -155,12 +155,7 @@ fn improves(
 /// Per-face quality of the working mesh in the unscaled metric (what `eval` measures).
 fn qualities(ctx: &RunContext<'_>, state: &LoopState) -> Vec<TriangleQuality> {
     let mesh = &state.work.mesh;
-    let metrics: Vec<nalgebra::Matrix3<f64>> = state
-        .work
-        .locations
-        .iter()
-        .map(|l| ctx.quality_field.eval_at(l))
-        .collect();
+    let metrics = state.vertex_metrics(ctx);
     mesh.faces()
         .map(|f| triangle_quality(mesh.face_points(f), &face_metric(&metrics, mesh.face(f))))
         .collect()

@@ -256,6 +256,16 @@ impl LoopState {
         true
     }
 
+    /// The unscaled metric (what `eval` measures in) at every working-mesh vertex's reference
+    /// location.
+    pub fn vertex_metrics(&self, ctx: &RunContext<'_>) -> Vec<nalgebra::Matrix3<f64>> {
+        self.work
+            .locations
+            .iter()
+            .map(|l| ctx.quality_field.eval_at(l))
+            .collect()
+    }
+
     /// What the strategy sees.
     pub fn patch_context<'s>(&'s self, ctx: &'s RunContext<'_>) -> PatchContext<'s> {
         PatchContext {

@@ -141,18 +141,13 @@ fn certify_features(state: &LoopState) -> Result<(), PipelineError> {
 /// The faces touching a seam (an edge whose two faces came from different patches, or from a
 /// patch and the input) against the rest, in the unscaled metric.
 fn seam_quality(
-    ctx: &RunContext<'_>,
     work: &crate::stitch::WorkingMesh,
     face_patch: &[Option<PatchId>],
+    metrics: &[nalgebra::Matrix3<f64>],
 ) -> SeamQuality {
     use crate::quality::{face_metric, triangle_quality};
     let mesh = &work.mesh;
     let topo = Topology::build(mesh);
-    let metrics: Vec<nalgebra::Matrix3<f64>> = work
-        .locations
-        .iter()
-        .map(|l| ctx.quality_field.eval_at(l))
-        .collect();
     let mut seam = vec![false; mesh.n_faces()];
     for f in mesh.faces() {
         for i in 0..3 {
@@ -167,7 +162,7 @@ fn seam_quality(
         let qs: Vec<_> = mesh
             .faces()
             .filter(|f| seam[f.idx()] == on)
-            .map(|f| triangle_quality(mesh.face_points(f), &face_metric(&metrics, mesh.face(f))))
+            .map(|f| triangle_quality(mesh.face_points(f), &face_metric(metrics, mesh.face(f))))
             .collect();
         let n = qs.len();
         let nf = n.max(1) as f64;
@@ -194,12 +189,7 @@ fn seam_quality(
 fn sizes_on_target(ctx: &RunContext<'_>, state: &LoopState) -> Sizes {
     use crate::quality::edge_conformity_where;
     let mesh = &state.work.mesh;
-    let metrics: Vec<nalgebra::Matrix3<f64>> = state
-        .work
-        .locations
-        .iter()
-        .map(|l| ctx.quality_field.eval_at(l))
-        .collect();
+    let metrics = state.vertex_metrics(ctx);
     let free = |v: VertexId| state.bound.get(v.idx()).copied().unwrap_or(1.0) <= 1.0 + 1e-9;
     let l = ctx.plan.l_tar;
     let all = edge_conformity_where(mesh, &metrics, l, |_| true);
@@ -246,7 +236,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -
             output_pairs: cert.self_intersecting_pairs,
         });
     }
-    let seams = seam_quality(ctx, &state.work, &state.face_patch);
+    let seams = seam_quality(&state.work, &state.face_patch, &state.vertex_metrics(ctx));
     let sizes = sizes_on_target(ctx, &state);
     let out_topo = Topology::build(&state.work.mesh);
     let boundary_distance = crate::boundary::curve_distance(
