@@ -9,6 +9,15 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+/// `--improve-flips`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImproveFlips {
+    /// When the pair's Eq. 5 energy strictly decreases.
+    Energy,
+    /// When the pair's smaller metric quality strictly increases.
+    MaxMin,
+}
+
 /// `--coarse`.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Coarse {
@@ -138,9 +147,16 @@ pub struct RemeshArgs {
     /// With `--improve`: the quality below which a face is improved.
     #[arg(long, default_value_t = conemesh::pipeline::ImproveOptions::default().q_threshold)]
     pub improve_q: f64,
-    /// With `--improve`: rings of faces around a bad face that its patch takes.
+    /// With `--improve`: rings of faces around a bad face that its patch takes in the first
+    /// pass (one more in each further pass).
     #[arg(long, default_value_t = conemesh::pipeline::ImproveOptions::default().rings)]
     pub improve_rings: usize,
+    /// With `--improve`: how the connectivity update decides a flip.
+    #[arg(long, value_enum, default_value_t = ImproveFlips::Energy)]
+    pub improve_flips: ImproveFlips,
+    /// With `--improve`: the weight w of Eq. 5.
+    #[arg(long, default_value_t = conemesh::improve::Eq5Options::default().w)]
+    pub improve_w: f64,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -307,6 +323,14 @@ fn options(args: &RemeshArgs) -> RemeshOptions {
             enabled: args.improve,
             q_threshold: args.improve_q,
             rings: args.improve_rings,
+            planar: conemesh::improve::Eq5Options {
+                w: args.improve_w,
+                flip_rule: match args.improve_flips {
+                    ImproveFlips::Energy => conemesh::improve::FlipRule::Energy,
+                    ImproveFlips::MaxMin => conemesh::improve::FlipRule::MaxMin,
+                },
+                ..conemesh::improve::Eq5Options::default()
+            },
             ..conemesh::pipeline::ImproveOptions::default()
         },
         ..RemeshOptions::default()

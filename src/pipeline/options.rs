@@ -141,6 +141,24 @@ pub struct ImproveOptions {
     pub planar: crate::improve::Eq5Options,
 }
 
+impl ImproveOptions {
+    /// Errors for values no run can use, naming the option.
+    pub fn validate(&self) -> Result<(), String> {
+        let q = self.q_threshold;
+        if !(q.is_finite() && q > 0.0 && q <= 1.0) {
+            return Err(format!("improvement threshold must be in (0, 1], got {q}"));
+        }
+        let w = self.planar.w;
+        if !(w.is_finite() && w > 0.0) {
+            return Err(format!("Eq. 5 weight w must be a positive number, got {w}"));
+        }
+        if self.rings == 0 {
+            return Err("improvement rings must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
 impl Default for ImproveOptions {
     fn default() -> Self {
         ImproveOptions {
@@ -187,6 +205,7 @@ impl RemeshOptions {
             }
         }
         self.sizes.validate()?;
+        self.improve.validate()?;
         let b = self.boundary.corner_angle;
         if !(b.is_finite() && b > 0.0 && b <= 180.0) {
             return Err(format!(
@@ -288,5 +307,26 @@ impl Stages {
             self.parameterizer.name().to_string(),
             self.remesher.name().to_string(),
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn improvement_options_no_run_can_use_are_named() {
+        let bad = |f: fn(&mut ImproveOptions)| {
+            let mut o = RemeshOptions::default();
+            f(&mut o.improve);
+            o.validate().expect_err("refused")
+        };
+        assert!(bad(|i| i.q_threshold = 0.0).contains("threshold"));
+        assert!(bad(|i| i.q_threshold = f64::NAN).contains("threshold"));
+        assert!(bad(|i| i.q_threshold = 1.5).contains("threshold"));
+        assert!(bad(|i| i.planar.w = -1.0).contains("weight w"));
+        assert!(bad(|i| i.planar.w = f64::INFINITY).contains("weight w"));
+        assert!(bad(|i| i.rings = 0).contains("rings"));
+        assert!(RemeshOptions::default().validate().is_ok());
     }
 }
