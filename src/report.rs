@@ -277,6 +277,36 @@ pub fn write_quality_plots_with(
     Ok(out)
 }
 
+/// The smallest-angle histogram before and after Algorithm 2 (`hist_min_angles_improve.png`
+/// in `dir`), each in % of its faces; `before` and `after` are 10° bins from 0°.
+pub fn write_improvement_plot(
+    dir: &Path,
+    name: &str,
+    before: &[usize],
+    after: &[usize],
+    theta_min: (f64, f64),
+) -> Result<PathBuf, ReportError> {
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::Os {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    let bins = |h: &[usize]| h.iter().take(7).copied().collect::<Vec<_>>();
+    let h = Histogram {
+        file: "hist_min_angles_improve.png",
+        title: format!(
+            "{name}: smallest angle per triangle, Algorithm 2  (min {:.1}° → {:.1}°)",
+            theta_min.0, theta_min.1
+        ),
+        x_desc: "smallest angle in the metric (degrees)",
+        y_desc: "% of triangles",
+        x_max: 70.0,
+        series: vec![("before", bins(before)), ("after", bins(after))],
+    };
+    let p = dir.join(h.file);
+    draw_histogram(&p, &h, font_available())?;
+    Ok(p)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -85,3 +85,50 @@ fn same_seed_same_bytes_with_the_improvement() {
     assert!(imp.after.theta_min >= imp.before.theta_min, "{imp:?}");
     assert!(imp.after.q_min >= imp.before.q_min, "{imp:?}");
 }
+
+#[test]
+fn the_cli_reports_and_plots_the_step_and_refuses_bad_values() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out_mesh = dir.path().join("out.obj");
+    let report = dir.path().join("r.json");
+    let plots = dir.path().join("plots");
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_conemesh"))
+            .arg("remesh")
+            .arg("-o")
+            .arg(&out_mesh)
+            .args(["--quiet", "--improve"])
+            .args(extra)
+            .output()
+            .expect("runs")
+    };
+    let o = run(&[
+        "--improve-q",
+        "0.9",
+        "--report",
+        report.to_str().unwrap(),
+        "--plots",
+        plots.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let imp = &doc["run"]["improvement"];
+    assert!(imp["patches"].as_u64().unwrap() > 0, "{imp}");
+    let hist: Vec<u64> = imp["after"]["hist_min_angles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    assert_eq!(hist.iter().sum::<u64>(), imp["after"]["faces"].as_u64().unwrap());
+    assert!(plots.join("hist_min_angles_improve.png").is_file());
+    for bad in [["--improve-q", "1.5"], ["--improve-w", "nan"], ["--improve-rings", "0"]] {
+        std::fs::remove_file(&out_mesh).ok();
+        let o = run(&bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("improvement") || err.contains("weight w"), "{err}");
+        assert!(!out_mesh.exists(), "no output for {bad:?}");
+    }
+}

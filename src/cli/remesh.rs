@@ -81,7 +81,8 @@ pub struct RemeshArgs {
     /// Write the full report (options, certificates, per-stage times, quality) as JSON.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Write quality histograms (PNG) into this directory.
+    /// Write quality histograms (PNG) into this directory (with `--improve`, also the smallest
+    /// angles before and after Algorithm 2).
     #[arg(long)]
     pub plots: Option<PathBuf>,
     /// Write the metric at the output vertices (Medit .sol, file units): the metric the mesh
@@ -271,6 +272,16 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             ],
         )
         .with_context(|| format!("writing plots into {}", dir.display()))?;
+        if let Some(i) = &out.unit.report.improvement {
+            conemesh::report::write_improvement_plot(
+                dir,
+                &short_name,
+                &i.before.hist_min_angles,
+                &i.after.hist_min_angles,
+                (i.before.theta_min, i.after.theta_min),
+            )
+            .with_context(|| format!("writing plots into {}", dir.display()))?;
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

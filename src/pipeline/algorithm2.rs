@@ -175,5 +175,6 @@ fn summary(qs: &[TriangleQuality]) -> AngleSummary {
         below_20: below(20.0),
         below_25: below(25.0),
         below_30: below(30.0),
+        hist_min_angles: crate::quality::stats_of(qs).hist_min_angles,
     }
 }

@@ -278,6 +278,8 @@ pub struct AngleSummary {
     pub below_25: usize,
     /// Below 30°.
     pub below_30: usize,
+    /// Faces per 10° bin of their smallest angle (`[0°, 10°)`, …), as `eval`'s histogram.
+    pub hist_min_angles: [usize; 18],
 }
 
 /// What Algorithm 2 (minimum-angle improvement, Sec. 3.4) did: the Table-1 row before and
