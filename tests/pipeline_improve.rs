@@ -121,14 +121,24 @@ fn the_cli_reports_and_plots_the_step_and_refuses_bad_values() {
         .iter()
         .map(|v| v.as_u64().unwrap())
         .collect();
-    assert_eq!(hist.iter().sum::<u64>(), imp["after"]["faces"].as_u64().unwrap());
+    assert_eq!(
+        hist.iter().sum::<u64>(),
+        imp["after"]["faces"].as_u64().unwrap()
+    );
     assert!(plots.join("hist_min_angles_improve.png").is_file());
-    for bad in [["--improve-q", "1.5"], ["--improve-w", "nan"], ["--improve-rings", "0"]] {
+    for bad in [
+        ["--improve-q", "1.5"],
+        ["--improve-w", "nan"],
+        ["--improve-rings", "0"],
+    ] {
         std::fs::remove_file(&out_mesh).ok();
         let o = run(&bad);
         assert_eq!(o.status.code(), Some(2), "{bad:?}");
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(err.contains("improvement") || err.contains("weight w"), "{err}");
+        assert!(
+            err.contains("improvement") || err.contains("weight w"),
+            "{err}"
+        );
         assert!(!out_mesh.exists(), "no output for {bad:?}");
     }
 }

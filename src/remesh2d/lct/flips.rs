@@ -30,17 +30,9 @@ impl Work<'_> {
             if n >= cap {
                 break;
             }
-            if self.is_locked(a, b) {
-                continue;
-            }
-            let (Some(&t1), Some(&t2)) = (self.he.get(&key(a, b)), self.he.get(&key(b, a))) else {
+            let Some((t1, t2, c, d)) = self.flippable(a, b) else {
                 continue;
             };
-            let c = self.rotated(t1, a)[2];
-            let d = self.rotated(t2, b)[2];
-            if c == d || self.he.contains_key(&key(c, d)) || self.he.contains_key(&key(d, c)) {
-                continue;
-            }
             let (n1, n2) = ([a, d, c], [d, b, c]);
             if !self.positive(n1) || !self.positive(n2) {
                 continue;
@@ -117,17 +109,9 @@ impl Work<'_> {
             .into_iter()
             .collect();
         for (a, b) in edges {
-            if self.is_locked(a, b) {
-                continue;
-            }
-            let (Some(&t1), Some(&t2)) = (self.he.get(&key(a, b)), self.he.get(&key(b, a))) else {
+            let Some((t1, t2, c, d)) = self.flippable(a, b) else {
                 continue;
             };
-            let c = self.rotated(t1, a)[2];
-            let d = self.rotated(t2, b)[2];
-            if c == d || self.he.contains_key(&key(c, d)) || self.he.contains_key(&key(d, c)) {
-                continue;
-            }
             let dev = |x: u32, dv: i32| {
                 let e = val[x as usize] + dv - target[x as usize];
                 e * e
@@ -155,5 +139,18 @@ impl Work<'_> {
             count += 1;
         }
         count
+    }
+
+    /// The two triangles `(a, b, c)` and `(b, a, d)` of the interior unlocked edge `(a, b)`
+    /// and their apexes, when flipping it to `(c, d)` would not duplicate an edge.
+    fn flippable(&self, a: u32, b: u32) -> Option<(u32, u32, u32, u32)> {
+        if self.is_locked(a, b) {
+            return None;
+        }
+        let (&t1, &t2) = (self.he.get(&key(a, b))?, self.he.get(&key(b, a))?);
+        let c = self.rotated(t1, a)[2];
+        let d = self.rotated(t2, b)[2];
+        let exists = self.he.contains_key(&key(c, d)) || self.he.contains_key(&key(d, c));
+        (c != d && !exists).then_some((t1, t2, c, d))
     }
 }
