@@ -187,7 +187,7 @@ fn sqrt_spd(m: &Matrix2<f64>) -> Option<Matrix2<f64>> {
 fn log_sum_exp(w: f64, fs: &[f64]) -> f64 {
     let max = fs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     if !max.is_finite() {
-        return max.max(f64::INFINITY * fs.len().min(1) as f64);
+        return max;
     }
     w * max + fs.iter().map(|f| (w * (f - max)).exp()).sum::<f64>().ln()
 }
@@ -345,9 +345,7 @@ impl State<'_> {
                 continue;
             };
             // The two triangles may have changed by an earlier flip of this pass.
-            if self.tris[t1 as usize] != rotate_to(self.tris[t1 as usize], a, b, c)
-                || self.tris[t2 as usize] != rotate_to(self.tris[t2 as usize], b, a, d)
-            {
+            if !reads(self.tris[t1 as usize], a, b, c) || !reads(self.tris[t2 as usize], b, a, d) {
                 continue;
             }
             let (n1, n2) = ([c, d, b], [d, c, a]);
@@ -398,15 +396,9 @@ impl State<'_> {
     }
 }
 
-/// `t` rotated so that it reads `(a, b, c)` when it is that triangle, else `t` unchanged
-/// turned into something that compares unequal.
-fn rotate_to(t: [u32; 3], a: u32, b: u32, c: u32) -> [u32; 3] {
-    for k in 0..3 {
-        if t[k] == a && t[(k + 1) % 3] == b && t[(k + 2) % 3] == c {
-            return t;
-        }
-    }
-    [u32::MAX; 3]
+/// `t` is the triangle `(a, b, c)`, in some rotation.
+fn reads(t: [u32; 3], a: u32, b: u32, c: u32) -> bool {
+    (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b && t[(k + 2) % 3] == c)
 }
 
 /// Algorithm 2's planar updates on `domain`'s own triangulation (its boundary and constrained

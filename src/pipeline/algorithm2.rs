@@ -28,7 +28,7 @@ use crate::ids::FaceId;
 use crate::improve::Eq5Improver;
 use crate::param::SymmetricDirichlet;
 use crate::patches::{ConeOptions, ConePatches};
-use crate::quality::{face_metric, triangle_quality, TriangleQuality};
+use crate::quality::{face_qualities, stats_of, triangle_quality, TriangleQuality};
 use crate::stitch::{PatchVertex, Replacement};
 use std::time::Instant;
 
@@ -154,27 +154,23 @@ fn improves(
 
 /// Per-face quality of the working mesh in the unscaled metric (what `eval` measures).
 fn qualities(ctx: &RunContext<'_>, state: &LoopState) -> Vec<TriangleQuality> {
-    let mesh = &state.work.mesh;
-    let metrics = state.vertex_metrics(ctx);
-    mesh.faces()
-        .map(|f| triangle_quality(mesh.face_points(f), &face_metric(&metrics, mesh.face(f))))
-        .collect()
+    face_qualities(&state.work.mesh, &state.vertex_metrics(ctx))
 }
 
 /// The Table-1 row of `qs` and its counts of small angles.
 fn summary(qs: &[TriangleQuality]) -> AngleSummary {
-    let n = qs.len().max(1) as f64;
+    let stats = stats_of(qs);
     let below = |deg: f64| qs.iter().filter(|t| t.min_angle() < deg).count();
     AngleSummary {
-        faces: qs.len(),
-        q_min: qs.iter().map(|t| t.q).fold(1.0, f64::min),
-        q_avg: qs.iter().map(|t| t.q).sum::<f64>() / n,
-        theta_min: qs.iter().map(|t| t.min_angle()).fold(180.0, f64::min),
-        theta_avg: qs.iter().map(|t| t.min_angle()).sum::<f64>() / n,
+        faces: stats.faces,
+        q_min: stats.q_min,
+        q_avg: stats.q_avg,
+        theta_min: stats.theta_min,
+        theta_avg: stats.theta_avg,
         below_10: below(10.0),
         below_20: below(20.0),
         below_25: below(25.0),
         below_30: below(30.0),
-        hist_min_angles: crate::quality::stats_of(qs).hist_min_angles,
+        hist_min_angles: stats.hist_min_angles,
     }
 }
