@@ -136,3 +136,29 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(config(6))]
+
+    /// Algorithm 2's planar updates (not a registry row: they keep the patch's vertices) keep
+    /// the planar remesher's contract on the demo domains with random interior vertices, for
+    /// both flip rules.
+    #[test]
+    fn the_planar_updates_of_algorithm_2_keep_the_contract(case in 0usize..6, seed in 0u64..1000) {
+        use conemesh::improve::{Eq5Improver, Eq5Options, FlipRule};
+        let (domain, metric) = conemesh::remesh2d::demo_cases()[case];
+        let boundary = resample_polygon(&domain.corners(), &metric, 0.15);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let inside: Vec<nalgebra::Point2<f64>> = (0..40)
+            .map(|_| nalgebra::Point2::new(rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)))
+            .collect();
+        let dom = triangulate_polygon(&boundary, &inside).expect("a triangulated polygon");
+        for flip_rule in [FlipRule::Energy, FlipRule::MaxMin] {
+            let improver = Eq5Improver {
+                options: Eq5Options { flip_rule, ..Eq5Options::default() },
+            };
+            let r = contract::planar_remesher(&improver, &dom, &metric, 0.15, seed);
+            prop_assert!(r.is_ok(), "{flip_rule:?}: {}", r.unwrap_err());
+        }
+    }
+}
