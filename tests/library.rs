@@ -268,6 +268,12 @@ fn the_cli_reaches_every_registry() {
         "weights=uniform",
         "--remesher-opt",
         "rounds=4",
+        "--improvers",
+        "eq5,surface",
+        "--improver-opt",
+        "surface.relocate=false",
+        "--improver-opt",
+        "eq5.q=0.9",
         "--report",
         &path("kring.json"),
         "--quiet",
@@ -283,6 +289,12 @@ fn the_cli_reaches_every_registry() {
         report["run"]["stages"],
         serde_json::json!(["kring", "tutte", "lct"])
     );
+    assert_eq!(
+        report["run"]["improvers"],
+        serde_json::json!(["eq5", "surface"])
+    );
+    // With relocation off the surface passes only flip.
+    assert_eq!(report["run"]["vertex_moves"], 0);
     for (args, says) in [
         (
             vec!["--strategy", "spiral"],

@@ -1,9 +1,13 @@
-//! Algorithm 2 (minimum-angle improvement, Sec. 3.4) through the library: certified like
-//! Algorithm 1, never worse at the bottom, counted, reproducible.
+//! The improvers after the loop (Sec. 3.4), Algorithm 2 above all, through the library:
+//! certified like Algorithm 1, never worse at the bottom, counted, reproducible; and the
+//! `Improver` extension point from outside the crate.
 
+use conemesh::improve::{
+    Algorithm2, ImproveOptions, ImproveRun, Improver, ImproverCounts, RunError, SurfacePasses,
+};
 use conemesh::invariants::certify_boundary_on_curves;
 use conemesh::mesh::{Topology, TriMesh};
-use conemesh::pipeline::{ImproveOptions, RemeshOptions, Remesher};
+use conemesh::pipeline::{RemeshOptions, Remesher, Stages};
 use std::path::Path;
 
 fn shared(name: &str) -> TriMesh {
@@ -11,14 +15,25 @@ fn shared(name: &str) -> TriMesh {
     conemesh::io::read_mesh(&path).expect("shared mesh").mesh
 }
 
-fn with_improve(q: f64, seed: u64) -> RemeshOptions {
+/// The default stages with Algorithm 2 (threshold `q`) after the surface passes.
+fn with_improve(q: f64) -> Stages {
+    Stages {
+        improvers: vec![
+            Box::new(SurfacePasses::default()),
+            Box::new(Algorithm2 {
+                options: ImproveOptions {
+                    q_threshold: q,
+                    ..ImproveOptions::default()
+                },
+            }),
+        ],
+        ..Stages::default()
+    }
+}
+
+fn seeded(seed: u64) -> RemeshOptions {
     RemeshOptions {
         seed,
-        improve: ImproveOptions {
-            enabled: true,
-            q_threshold: q,
-            ..ImproveOptions::default()
-        },
         ..RemeshOptions::default()
     }
 }
@@ -27,25 +42,28 @@ fn with_improve(q: f64, seed: u64) -> RemeshOptions {
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn the_screwdriver_loses_small_angles_and_stays_certified() {
     let input = shared("screwdriver.off");
-    let out = Remesher::new(with_improve(0.7, 1))
+    let out = Remesher::new(seeded(1))
+        .with_stages(with_improve(0.7))
         .run(&input)
         .expect("remeshes");
     let r = &out.unit.report;
-    let imp = r.improvement.expect("Algorithm 2 ran");
+    assert_eq!(r.improvers, ["surface", "eq5"]);
+    let all = r.improvement.as_ref().expect("the improvers ran");
+    let surface = all.step("surface").expect("surface passes ran");
+    let a2 = all.step("eq5").expect("Algorithm 2 ran");
+    let (before, after, c) = (&surface.after, &a2.after, &a2.counts);
     // It found faces to improve, in counted passes and patches.
-    assert!(
-        imp.patches > 0 && imp.passes >= 1 && imp.passes <= 3,
-        "{imp:?}"
-    );
-    assert!(!imp.budget_exhausted);
-    // Never worse at the bottom, and better here (measured: θ_min 11.8° → 19.5°, q_min
-    // 0.287 → 0.435, faces below 20° 5 → 1).
-    assert!(imp.after.theta_min > imp.before.theta_min + 5.0, "{imp:?}");
-    assert!(imp.after.q_min > imp.before.q_min + 0.1, "{imp:?}");
-    assert!(imp.after.below_20 < imp.before.below_20, "{imp:?}");
-    assert!(imp.rejected < imp.patches, "{imp:?}");
-    assert!(imp.after.q_avg >= imp.before.q_avg - 0.002, "{imp:?}");
-    assert_eq!(imp.after.faces, out.mesh.n_faces());
+    assert!(c.patches > 0 && c.passes >= 1 && c.passes <= 3, "{a2:?}");
+    assert!(!c.budget_exhausted);
+    // Never worse at the bottom, and better here (measured: θ_min 11.8° → 21.3°, q_min
+    // 0.287 → 0.440, faces below 20° 5 → 0).
+    assert!(after.theta_min > before.theta_min + 5.0, "{a2:?}");
+    assert!(after.q_min > before.q_min + 0.1, "{a2:?}");
+    assert!(after.below_20 < before.below_20, "{a2:?}");
+    assert!(c.rejected < c.patches, "{a2:?}");
+    assert!(after.q_avg >= before.q_avg - 0.002, "{a2:?}");
+    assert_eq!(after.faces, out.mesh.n_faces());
+    assert_eq!(&all.after, after);
     // Certified as Algorithm 1's patches: every patch (both algorithms) counted once for
     // the manifold and topology certificates, no flips, no self-intersections.
     let c = &r.certificate;
@@ -63,27 +81,119 @@ fn the_screwdriver_loses_small_angles_and_stays_certified() {
         &out.unit.curve,
     )
     .expect("boundary on the input's curves");
-    // Off by default: the same run without it is Algorithm 1's output.
-    let plain = Remesher::new(RemeshOptions::default())
+    // Without it the run makes fewer patches and ends at the surface passes' row.
+    let plain = Remesher::new(seeded(1)).run(&input).expect("remeshes");
+    let p = plain.unit.report.improvement.as_ref().expect("surface ran");
+    assert_eq!(
+        plain.unit.report.improvers,
+        conemesh::pipeline::DEFAULT_IMPROVERS
+    );
+    if !conemesh::pipeline::DEFAULT_IMPROVERS.contains(&"eq5") {
+        assert!(plain.unit.report.patches < r.patches);
+        assert_eq!(p.after, surface.after);
+    }
+}
+
+/// A research improver written outside the crate: one patch pass over every face through
+/// Algorithm 1's own stages, whose every candidate it refuses.
+struct RefuseEverything;
+
+impl Improver for RefuseEverything {
+    fn name(&self) -> &'static str {
+        "refuse-everything"
+    }
+    fn improve(
+        &self,
+        run: &mut dyn ImproveRun,
+        rng: &mut conemesh::Rng,
+    ) -> Result<ImproverCounts, RunError> {
+        let all = vec![true; run.working_mesh().mesh.n_faces()];
+        let stages = Stages::default();
+        let pass = run.patch_pass(stages.loop_stages(), &all, None, &|_, _| false, rng)?;
+        Ok(ImproverCounts {
+            passes: 1,
+            patches: pass.patches,
+            rejected: pass.rejected,
+            budget_exhausted: pass.budget_exhausted,
+            ..ImproverCounts::default()
+        })
+    }
+}
+
+#[test]
+fn an_improver_from_outside_the_crate_runs_certified_and_its_refusals_keep_the_mesh() {
+    let input = conemesh::mesh::generators::default_surface();
+    let options = || RemeshOptions {
+        max_patches: None,
+        ..seeded(3)
+    };
+    let plain = Remesher::new(options())
+        .with_stages(Stages {
+            improvers: vec![],
+            ..Stages::default()
+        })
         .run(&input)
-        .expect("remeshes");
+        .expect("plain");
     assert!(plain.unit.report.improvement.is_none());
-    assert!(plain.unit.report.patches < r.patches);
+    let refused = Remesher::new(options())
+        .with_stages(Stages {
+            improvers: vec![Box::new(RefuseEverything)],
+            ..Stages::default()
+        })
+        .run(&input)
+        .expect("with the research improver");
+    let r = &refused.unit.report;
+    let step = r
+        .improvement
+        .as_ref()
+        .and_then(|i| i.step("refuse-everything"));
+    let step = step.expect("it ran");
+    // It made patches over the whole surface, each certified (a patch counts once for the
+    // manifold certificate) and each refused, so the mesh is Algorithm 1's, bytes and all.
+    assert!(step.counts.patches > 0, "{step:?}");
+    assert_eq!(step.counts.rejected, step.counts.patches);
+    assert_eq!(r.patches, plain.unit.report.patches + step.counts.patches);
+    assert_eq!(r.certificate.manifold, r.patches);
+    assert_eq!(refused.mesh.positions, plain.mesh.positions);
+    assert_eq!(refused.mesh.triangles, plain.mesh.triangles);
+    // A bad option of an improver is refused before any work, naming it.
+    let bad = Remesher::new(options())
+        .with_stages(Stages {
+            improvers: vec![Box::new(Algorithm2 {
+                options: ImproveOptions {
+                    rings: 0,
+                    ..ImproveOptions::default()
+                },
+            })],
+            ..Stages::default()
+        })
+        .run(&input);
+    assert!(
+        matches!(&bad, Err(e) if e.to_string().contains("eq5") && e.to_string().contains("rings")),
+        "{:?}",
+        bad.err()
+    );
 }
 
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn same_seed_same_bytes_with_the_improvement() {
     let input = shared("3holes.off");
-    let a = Remesher::new(with_improve(0.8, 2)).run(&input).expect("a");
-    let b = Remesher::new(with_improve(0.8, 2)).run(&input).expect("b");
+    let run = || {
+        Remesher::new(seeded(2))
+            .with_stages(with_improve(0.8))
+            .run(&input)
+            .expect("runs")
+    };
+    let (a, b) = (run(), run());
     assert_eq!(a.mesh.positions, b.mesh.positions);
     assert_eq!(a.mesh.triangles, b.mesh.triangles);
     let imp = a.unit.report.improvement.expect("ran");
+    let (before, after) = (imp.steps[0].after, imp.steps[1].after);
     // A patch is replaced only when neither its smallest quality nor its smallest angle
     // drops, so the mesh's cannot.
-    assert!(imp.after.theta_min >= imp.before.theta_min, "{imp:?}");
-    assert!(imp.after.q_min >= imp.before.q_min, "{imp:?}");
+    assert!(after.theta_min >= before.theta_min, "{imp:?}");
+    assert!(after.q_min >= before.q_min, "{imp:?}");
 }
 
 #[test]
@@ -97,12 +207,13 @@ fn the_cli_reports_and_plots_the_step_and_refuses_bad_values() {
             .arg("remesh")
             .arg("-o")
             .arg(&out_mesh)
-            .args(["--quiet", "--improve"])
+            .arg("--quiet")
             .args(extra)
             .output()
             .expect("runs")
     };
     let o = run(&[
+        "--improve",
         "--improve-q",
         "0.9",
         "--report",
@@ -114,7 +225,11 @@ fn the_cli_reports_and_plots_the_step_and_refuses_bad_values() {
     let doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     let imp = &doc["run"]["improvement"];
-    assert!(imp["patches"].as_u64().unwrap() > 0, "{imp}");
+    assert_eq!(imp["steps"][1]["name"], "eq5", "{imp}");
+    assert!(
+        imp["steps"][1]["counts"]["patches"].as_u64().unwrap() > 0,
+        "{imp}"
+    );
     let hist: Vec<u64> = imp["after"]["hist_min_angles"]
         .as_array()
         .unwrap()
@@ -126,19 +241,31 @@ fn the_cli_reports_and_plots_the_step_and_refuses_bad_values() {
         imp["after"]["faces"].as_u64().unwrap()
     );
     assert!(plots.join("hist_min_angles_improve.png").is_file());
-    for bad in [
-        ["--improve-q", "1.5"],
-        ["--improve-w", "nan"],
-        ["--improve-rings", "0"],
+    for (bad, named) in [
+        (&["--improve", "--improve-q", "1.5"][..], "`q`"),
+        (&["--improve", "--improve-w", "nan"], "`w`"),
+        (&["--improve", "--improve-rings", "0"], "`rings`"),
+        (&["--improve", "--improver-opt", "eq5.q=2"], "`q`"),
+        (
+            &["--improvers", "surface", "--improver-opt", "eq5.q=0.5"],
+            "does not run",
+        ),
+        (&["--improver-opt", "surface.q=0.5"], "no option `q`"),
+        (&["--improver-opt", "eq5q=0.5"], "NAME.KEY=VALUE"),
+        (
+            &["--improvers", "surface,laplace"],
+            "unknown improver `laplace`",
+        ),
+        (
+            &["--improvers", "surface", "--improve-q", "0.5"],
+            "does not run",
+        ),
     ] {
         std::fs::remove_file(&out_mesh).ok();
-        let o = run(&bad);
+        let o = run(bad);
         assert_eq!(o.status.code(), Some(2), "{bad:?}");
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(
-            err.contains("improvement") || err.contains("weight w"),
-            "{err}"
-        );
+        assert!(err.contains(named), "{bad:?}: {err}");
         assert!(!out_mesh.exists(), "no output for {bad:?}");
     }
 }

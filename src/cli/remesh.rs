@@ -139,25 +139,35 @@ pub struct RemeshArgs {
     /// and stay.
     #[arg(long, default_value_t = conemesh::boundary::BoundaryOptions::default().corner_angle)]
     pub boundary_corner_angle: f64,
-    /// Run Algorithm 2 (minimum-angle improvement, Sec. 3.4) after the loop: cone patches
-    /// around the faces whose metric quality is below `--improve-q`, improved in the plane by
-    /// the vertex position and connectivity updates of Eq. 5-6. Off by default while it is
-    /// measured.
-    #[arg(long)]
+    /// The improvers after the loop (Sec. 3.4), in order, by registry name, comma-separated
+    /// (`conemesh stages` lists them); `none` for none. Default: `surface` (the connectivity and
+    /// vertex position updates on the surface).
+    #[arg(long, value_name = "LIST")]
+    pub improvers: Option<String>,
+    /// An option of one improver, `NAME.KEY=VALUE` (e.g. `eq5.q=0.7`); repeatable.
+    #[arg(long, value_name = "NAME.KEY=VALUE")]
+    pub improver_opt: Vec<String>,
+    /// Add Algorithm 2 (minimum-angle improvement, improver `eq5`) after the default
+    /// improvers: cone patches around the faces whose metric quality is below `--improve-q`,
+    /// improved in the plane by the vertex position and connectivity updates of Eq. 5-6.
+    #[arg(long, conflicts_with = "no_improve")]
     pub improve: bool,
-    /// With `--improve`: the quality below which a face is improved.
-    #[arg(long, default_value_t = conemesh::pipeline::ImproveOptions::default().q_threshold)]
-    pub improve_q: f64,
-    /// With `--improve`: rings of faces around a bad face that its patch takes in the first
-    /// pass (one more in each further pass).
-    #[arg(long, default_value_t = conemesh::pipeline::ImproveOptions::default().rings)]
-    pub improve_rings: usize,
-    /// With `--improve`: how the connectivity update decides a flip.
-    #[arg(long, value_enum, default_value_t = ImproveFlips::Energy)]
-    pub improve_flips: ImproveFlips,
-    /// With `--improve`: the weight w of Eq. 5.
-    #[arg(long, default_value_t = conemesh::improve::Eq5Options::default().w)]
-    pub improve_w: f64,
+    /// Leave Algorithm 2 (`eq5`) out of the improvers.
+    #[arg(long)]
+    pub no_improve: bool,
+    /// Algorithm 2: the quality below which a face is improved [0.5] (`eq5.q`).
+    #[arg(long)]
+    pub improve_q: Option<f64>,
+    /// Algorithm 2: rings of faces around a bad face that its patch takes in the first pass,
+    /// one more in each further pass [2] (`eq5.rings`).
+    #[arg(long)]
+    pub improve_rings: Option<usize>,
+    /// Algorithm 2: how the connectivity update decides a flip [energy] (`eq5.flips`).
+    #[arg(long, value_enum)]
+    pub improve_flips: Option<ImproveFlips>,
+    /// Algorithm 2: the weight w of Eq. 5 [1] (`eq5.w`).
+    #[arg(long)]
+    pub improve_w: Option<f64>,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -233,6 +243,22 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             _ => "not checked".to_string(),
         }
     );
+    if let Some(i) = &r.improvement {
+        let (b, a) = (&i.before, &i.after);
+        println!(
+            "improvers {}: θ_min {:.2}° → {:.2}°, q_min {:.3} → {:.3}, faces below 20° {} → {}, below 25° {} → {}, {:.2} s",
+            r.improvers.join(","),
+            b.theta_min,
+            a.theta_min,
+            b.q_min,
+            a.q_min,
+            b.below_20,
+            a.below_20,
+            b.below_25,
+            a.below_25,
+            i.seconds
+        );
+    }
     if r.coarse_input {
         println!(
             "coarse-input profile ran ({} sweeps, fidelity floor {} of the mean input edge, {} rounds, persistent factors)",
@@ -330,20 +356,6 @@ fn options(args: &RemeshArgs) -> RemeshOptions {
             Coarse::On => CoarseInput::On,
             Coarse::Off => CoarseInput::Off,
         },
-        improve: conemesh::pipeline::ImproveOptions {
-            enabled: args.improve,
-            q_threshold: args.improve_q,
-            rings: args.improve_rings,
-            planar: conemesh::improve::Eq5Options {
-                w: args.improve_w,
-                flip_rule: match args.improve_flips {
-                    ImproveFlips::Energy => conemesh::improve::FlipRule::Energy,
-                    ImproveFlips::MaxMin => conemesh::improve::FlipRule::MaxMin,
-                },
-                ..conemesh::improve::Eq5Options::default()
-            },
-            ..conemesh::pipeline::ImproveOptions::default()
-        },
         ..RemeshOptions::default()
     }
 }
@@ -358,12 +370,79 @@ fn stages(args: &RemeshArgs, user_metric: bool) -> anyhow::Result<Stages> {
     if let Some(m) = args.max_patch_faces {
         strategy.set("max_faces", m);
     }
-    Ok(Stages::from_registry(
+    let mut stages = Stages::from_registry(
         (&args.strategy, strategy),
         (&args.param, Params::parse(&args.param_opt)?),
         (&args.remesher, Params::parse(&args.remesher_opt)?),
         user_metric,
-    )?)
+    )?;
+    stages.improvers = improvers(args)?;
+    Ok(stages)
+}
+
+/// The improvers of `--improvers` (or the default list), with `--improve`/`--no-improve`,
+/// `--improver-opt NAME.KEY=VALUE` and the `--improve-*` shorthands of row `eq5`.
+fn improvers(args: &RemeshArgs) -> anyhow::Result<Vec<Box<dyn conemesh::improve::Improver>>> {
+    let mut names: Vec<String> = match args.improvers.as_deref().map(str::trim) {
+        Some("none") | Some("") => Vec::new(),
+        Some(list) => list.split(',').map(|n| n.trim().to_string()).collect(),
+        None => conemesh::pipeline::DEFAULT_IMPROVERS
+            .iter()
+            .map(|n| n.to_string())
+            .collect(),
+    };
+    if args.improve && !names.iter().any(|n| n == "eq5") {
+        names.push("eq5".into());
+    }
+    if args.no_improve {
+        names.retain(|n| n != "eq5");
+    }
+    let mut params: Vec<Vec<String>> = vec![Vec::new(); names.len()];
+    let mut give = |name: &str, kv: String, flag: &str| -> anyhow::Result<()> {
+        match names.iter().position(|n| n == name) {
+            Some(i) => {
+                params[i].push(kv);
+                Ok(())
+            }
+            None => anyhow::bail!(
+                "{flag} is an option of improver `{name}`, which does not run (improvers: {})",
+                match names.is_empty() {
+                    true => "none".to_string(),
+                    false => names.join(","),
+                }
+            ),
+        }
+    };
+    for item in &args.improver_opt {
+        let (name, kv) = item
+            .split_once('.')
+            .filter(|(n, kv)| !n.is_empty() && kv.contains('='))
+            .ok_or_else(|| {
+                anyhow::anyhow!("--improver-opt `{item}` is not of the form NAME.KEY=VALUE")
+            })?;
+        give(name, kv.to_string(), "--improver-opt")?;
+    }
+    if let Some(q) = args.improve_q {
+        give("eq5", format!("q={q}"), "--improve-q")?;
+    }
+    if let Some(r) = args.improve_rings {
+        give("eq5", format!("rings={r}"), "--improve-rings")?;
+    }
+    if let Some(f) = args.improve_flips {
+        let rule = match f {
+            ImproveFlips::Energy => "energy",
+            ImproveFlips::MaxMin => "max-min",
+        };
+        give("eq5", format!("flips={rule}"), "--improve-flips")?;
+    }
+    if let Some(w) = args.improve_w {
+        give("eq5", format!("w={w}"), "--improve-w")?;
+    }
+    names
+        .iter()
+        .zip(params)
+        .map(|(name, p)| Ok(conemesh::improve::improver(name, Params::parse(&p)?)?))
+        .collect()
 }
 
 fn progress_bar(quiet: bool, total: u64) -> ProgressBar {

@@ -1,5 +1,6 @@
 //! `conemesh stages`: the registered implementations of each research extension point, with
-//! their options (what `remesh --strategy/--param/--remesher NAME --*-opt KEY=VALUE` takes).
+//! their options (what `remesh --strategy/--param/--remesher NAME --*-opt KEY=VALUE` and `--improvers`
+//! take).
 
 use conemesh::registry::Entry;
 use std::process::ExitCode;
@@ -35,5 +36,15 @@ pub fn run(_: StagesArgs) -> anyhow::Result<ExitCode> {
         "--remesher",
         conemesh::remesh2d::REMESHERS,
     );
+    println!(
+        "improvers, Sec. 3.4, run in order after the loop (--improvers A,B; --improver-opt NAME.KEY=VALUE; default: {}):",
+        conemesh::pipeline::DEFAULT_IMPROVERS.join(",")
+    );
+    for e in conemesh::improve::IMPROVERS {
+        println!("  {:<8} {}", e.name, e.summary);
+        for o in e.options {
+            println!("           {:<16} {}", o.name, o.doc);
+        }
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -9,6 +9,7 @@ use crate::boundary::BoundaryCurves;
 use crate::features::FeatureLines;
 use crate::fidelity::VertexFactors;
 use crate::ids::{EdgeKey, PatchId, VertexId};
+use crate::improve::{Improver, LoopStages};
 use crate::invariants::{self, FlipTest, TopologySignature};
 use crate::mesh::Topology;
 use crate::metric::MetricField;
@@ -24,8 +25,10 @@ pub struct RunContext<'a> {
     pub quality_field: &'a MetricField,
     /// The sizes and the effective options.
     pub plan: &'a Plan,
-    /// The extension points.
-    pub stages: &'a Stages,
+    /// The stages each patch goes through.
+    pub stages: LoopStages<'a>,
+    /// The improvers after the loop, in order.
+    pub improvers: &'a [Box<dyn Improver>],
     /// The flip certificate against the reference.
     pub flip_test: FlipTest,
     /// Area-weighted vertex normals of the reference (the fidelity control's).
@@ -80,7 +83,8 @@ impl<'a> RunContext<'a> {
             curves,
             quality_field: field,
             plan,
-            stages,
+            stages: stages.loop_stages(),
+            improvers: &stages.improvers,
             flip_test: FlipTest::new(reference),
             ref_normals: reference.area_weighted_normals(),
             input_pairs,
@@ -95,11 +99,12 @@ impl<'a> RunContext<'a> {
 
     /// The same run with other stages for Algorithm 2 (whose patches keep their boundary
     /// chains as they are).
-    pub fn for_improvement<'b>(&'b self, stages: &'b Stages) -> RunContext<'b> {
+    pub fn for_improvement<'b>(&'b self, stages: LoopStages<'b>) -> RunContext<'b> {
         RunContext {
             quality_field: self.quality_field,
             plan: self.plan,
             stages,
+            improvers: &[],
             flip_test: FlipTest::new(self.quality_field.reference()),
             ref_normals: self.ref_normals.clone(),
             input_pairs: self.input_pairs,

@@ -188,6 +188,14 @@ pub enum PipelineError {
     /// Invalid input or options.
     #[error("{0}")]
     Input(String),
+    /// An improver failed with an error of its own.
+    #[error("improver `{improver}`: {message}")]
+    Improver {
+        /// its name
+        improver: &'static str,
+        /// what it said
+        message: String,
+    },
 }
 
 fn seed_note(seed: &Option<VertexId>) -> String {

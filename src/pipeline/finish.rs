@@ -1,4 +1,4 @@
-//! After the loop of Algorithm 1: the surface passes of Sec. 3.4, the certificates of the
+//! After the loop of Algorithm 1 and its improvers: the certificates of the
 //! whole output, and the report.
 
 use super::context::{LoopState, RunContext};
@@ -6,45 +6,10 @@ use super::error::PipelineError;
 use super::records::{FaceSummary, RemeshReport, RemeshResult, SeamQuality, Sizes, Warning};
 use super::replace::certify_boundary;
 use crate::ids::{EdgeKey, PatchId, VertexId};
-use crate::improve::{finishing_passes, PassCounts, SurfaceContext};
 use crate::invariants::{self, FacePair, InvariantError, Offenders, TopologySignature};
 use crate::mesh::Topology;
 use crate::pipeline::options::CoarseInput;
 use std::time::Instant;
-
-/// The connectivity and vertex position updates on the surface
-/// ([`crate::improve::finishing_passes`]), within the fidelity tolerance (unbounded when the
-/// control is off, `--hausd 0`).
-pub fn improve(ctx: &RunContext<'_>, state: &mut LoopState) -> PassCounts {
-    let o = &ctx.plan.options;
-    if !(o.edge_flips || o.relocate) {
-        return PassCounts::default();
-    }
-    let t0 = Instant::now();
-    let surface = SurfaceContext {
-        field: ctx.quality_field,
-        flip_test: &ctx.flip_test,
-        embedded_input: ctx.embedded_input,
-        tol: passes_tolerance(ctx.plan.eps),
-        feature_edges: (!state.features.edges.is_empty()).then_some(&state.features.edges),
-        pinned: &state.pinned,
-        curves: Some(&ctx.curves),
-        slide_boundary: o.boundary.resample,
-    };
-    let counts = finishing_passes(&surface, &mut state.work, o.edge_flips, o.relocate);
-    state.counters.times.certify += t0.elapsed().as_secs_f64();
-    counts
-}
-
-/// How far the surface passes may move the surface: the fidelity tolerance, or no bound when
-/// the control is off (`--hausd 0`: the metric alone decides, as in the paper).
-fn passes_tolerance(eps: f64) -> f64 {
-    if eps > 0.0 {
-        eps
-    } else {
-        f64::INFINITY
-    }
-}
 
 /// The certificates of the whole output: the working mesh once more (the per-patch manifold
 /// check was local, by induction, and the passes changed it since), every corner and
@@ -206,7 +171,7 @@ fn sizes_on_target(ctx: &RunContext<'_>, state: &LoopState) -> Sizes {
 }
 
 /// The result of the run: the compacted mesh, its locations and provenance, and the report.
-pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -> RemeshResult {
+pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
     let plan = ctx.plan;
     let reference = ctx.quality_field.reference();
     let cert = &state.counters.cert;
@@ -230,6 +195,18 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -
             unprocessed: state.work.unprocessed(),
         });
     }
+    let steps = state.improvement.iter().flat_map(|i| &i.steps);
+    for s in steps.clone().filter(|s| s.counts.budget_exhausted) {
+        warnings.push(Warning::ImproverBudget {
+            improver: s.name.clone(),
+            patches: s.counts.patches,
+        });
+    }
+    let surface_counts = steps.fold(crate::improve::ImproverCounts::default(), |mut c, s| {
+        c.flips += s.counts.flips;
+        c.moves += s.counts.moves;
+        c
+    });
     if let Some(input_pairs) = cert.input_self_intersecting_pairs {
         warnings.push(Warning::InputSelfIntersects {
             input_pairs,
@@ -252,6 +229,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -
         boundary_distance,
         options: plan.options.clone(),
         stages: ctx.stages.names(),
+        improvers: ctx.improvers.iter().map(|i| i.name().to_string()).collect(),
         l_avg: plan.l_avg,
         l_tar: plan.l_tar,
         patches: state.patches,
@@ -263,8 +241,8 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -
         faces_in: reference.n_faces(),
         faces_out: state.work.mesh.n_faces(),
         vertices_out: state.work.mesh.n_vertices(),
-        edge_flips: passes.flips,
-        vertex_moves: passes.moves,
+        edge_flips: surface_counts.flips,
+        vertex_moves: surface_counts.moves,
         corners: ctx.corners.iter().filter(|c| **c).count(),
         feature_edges: state.features.input_edges,
         feature_pieces: state.features.edges.len(),
@@ -280,16 +258,5 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState, passes: PassCounts) -
         curve: state.work.curve,
         curves: ctx.curves.clone(),
         report,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    /// With the distance control off the passes are not bounded by the default tolerance
-    /// (they were before the house issue); with it on they use exactly the tolerance.
-    #[test]
-    fn passes_use_the_runs_tolerance() {
-        assert_eq!(super::passes_tolerance(0.0), f64::INFINITY);
-        assert_eq!(super::passes_tolerance(0.002), 0.002);
     }
 }

@@ -11,8 +11,9 @@
 //!     certify the candidate (no degenerate, flipped or intersecting new face)
 //!     stitch P' into the working mesh, mark its faces processed     // manifold, oriented,
 //!                                                                   // same topology, boundary
-//! connectivity and vertex position updates on the surface          // Sec. 3.4
-//! Algorithm 2 around the faces of low quality (opt-in)              // algorithm2.rs
+//! the improvers, in order: the connectivity and vertex position      // Sec. 3.4
+//!     updates on the surface; Algorithm 2 around the faces of low
+//!     quality (Eq. 5-6)                                             // improve::Improver
 //! at the end: the whole mesh again, and no self-intersections (exact)
 //! ```
 //!
@@ -22,16 +23,17 @@
 //!
 //! Files: `options.rs` (options and stages), `sizing.rs` (the [`Plan`] resolved before the
 //! loop), `context.rs` (what a run reads and the loop's state), `step.rs` (one patch with its
-//! retry ladder), `replace.rs` (stitching and the per-patch certificates), `finish.rs` (after
-//! the loop), `algorithm2.rs` (minimum-angle improvement), `records.rs` (report types),
+//! retry ladder), `replace.rs` (stitching and the per-patch certificates), `improvement.rs`
+//! (the improvers after the loop, [`ImproveRun`]), `finish.rs` (the certificates of the
+//! output, the report), `records.rs` (report types),
 //! `error.rs`, `debug.rs` (offending patches written out), `remesher.rs` (the whole job).
 
-mod algorithm2;
 mod chains;
 mod context;
 mod debug;
 mod error;
 mod finish;
+mod improvement;
 mod options;
 mod records;
 mod remesher;
@@ -40,10 +42,13 @@ mod sizing;
 mod step;
 
 pub use error::{PipelineError, Stage, StageError};
-pub use options::{CoarseInput, ImproveOptions, RemeshOptions, Stages, TargetLength, COARSE_RATIO};
+pub use options::{
+    default_improvers, CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO,
+    DEFAULT_IMPROVERS,
+};
 pub use records::{
-    AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, PatchRecord, Progress,
-    RemeshReport, RemeshResult, StageTimes, Warning,
+    AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,
+    PatchRecord, Progress, RemeshReport, RemeshResult, StageTimes, Warning,
 };
 pub use remesher::{Remeshed, Remesher};
 pub use sizing::{coarse_input_estimate, expected_faces, Plan, MAX_EXPECTED_FACES};
@@ -66,6 +71,10 @@ pub fn remesh(
     options: &RemeshOptions,
     mut on_progress: impl FnMut(Progress),
 ) -> Result<RemeshResult, PipelineError> {
+    for i in &stages.improvers {
+        i.validate()
+            .map_err(|e| PipelineError::Input(format!("improver `{}`: {e}", i.name())))?;
+    }
     let topo = certified_input_topology(field)?;
     let plan = Plan::resolve(field, &topo, options)?;
     let ctx = RunContext::new(plan.quality_field(field), topo, &plan, stages);
@@ -77,10 +86,9 @@ pub fn remesh(
         replace::replace_patch(&ctx, &mut state, outcome)?; // replace P, update M
         on_progress(state.progress(&ctx));
     }
-    let passes = finish::improve(&ctx, &mut state); // Sec. 3.4, on the surface
-    algorithm2::run(&ctx, &mut state, &mut rng)?; // Algorithm 2 (off by default)
+    improvement::run(&ctx, &mut state, &mut rng)?; // Sec. 3.4, the improvers in order
     finish::certify_output(&ctx, &mut state)?;
-    Ok(finish::into_result(&ctx, state, passes))
+    Ok(finish::into_result(&ctx, state))
 }
 
 /// The input must be an oriented 2-manifold (with or without boundary): say so up front,

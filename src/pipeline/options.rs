@@ -2,6 +2,7 @@
 
 use crate::boundary::BoundaryOptions;
 use crate::fidelity::FidelityOptions;
+use crate::improve::Improver;
 use crate::metric::SizeOptions;
 use crate::param::{Parameterizer, SymmetricDirichlet};
 use crate::patches::{ConePatches, PatchStrategy};
@@ -48,12 +49,6 @@ pub struct RemeshOptions {
     /// [`TransferMethod::JacobianPullback`]. Default `false` (paper-notes.md, Algorithm 1:
     /// it cuts thin tips).
     pub corner_pullback: bool,
-    /// After the loop, the connectivity update on the surface
-    /// ([`crate::improve::connectivity_update`]). Default `true`.
-    pub edge_flips: bool,
-    /// After the flips, the vertex position update on the surface
-    /// ([`crate::improve::vertex_position_update`]), then flips again. Default `true`.
-    pub relocate: bool,
     /// Input vertices whose angle defect `|2π − Σθ|` is at least this many radians are kept
     /// as vertices of the output (our addition, see [`crate::patches::corner_vertices`]): no
     /// patch contains them in its interior and the relocation pass does not move them.
@@ -71,8 +66,6 @@ pub struct RemeshOptions {
     /// The input's boundary (ours, [`crate::boundary`]): resampled to the metric on the input's
     /// boundary curves, corners kept (default), or kept vertex for vertex.
     pub boundary: BoundaryOptions,
-    /// The minimum-angle improvement (Algorithm 2, Sec. 3.4) after the loop.
-    pub improve: ImproveOptions,
     /// Whether to run the coarse-input profile ([`RemeshOptions::coarse_profile`]): `Auto`
     /// (default) runs it when the distance tolerance rather than the metric sets the output's
     /// size: the a-priori fidelity scaling multiplies the expected face count
@@ -110,64 +103,11 @@ impl Default for RemeshOptions {
             fidelity: FidelityOptions::default(),
             sweeps: 1,
             corner_pullback: false,
-            edge_flips: true,
-            relocate: true,
             corner_defect: Some(1.0),
             feature_angle: None,
             coarse_input: CoarseInput::Auto,
             boundary: BoundaryOptions::default(),
             sizes: SizeOptions::default(),
-            improve: ImproveOptions::default(),
-        }
-    }
-}
-
-/// Options of Algorithm 2 (Sec. 3.4), with their defaults.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ImproveOptions {
-    /// Run it (default `false` while its measurements are open, paper-notes.md Sec. 3.4).
-    pub enabled: bool,
-    /// A face whose metric quality q is below this is improved (default 0.5).
-    pub q_threshold: f64,
-    /// Passes over the faces below the threshold (default 3); a pass runs only while the
-    /// previous one strictly lowered their count.
-    pub passes: usize,
-    /// Rings of faces around a bad face that its patch takes in the first pass, one more in
-    /// each further pass (default 2).
-    pub rings: usize,
-    /// At most this many patches over all passes (default: no bound beyond the passes).
-    pub max_patches: Option<usize>,
-    /// The planar updates (Eq. 5-6).
-    pub planar: crate::improve::Eq5Options,
-}
-
-impl ImproveOptions {
-    /// Errors for values no run can use, naming the option.
-    pub fn validate(&self) -> Result<(), String> {
-        let q = self.q_threshold;
-        if !(q.is_finite() && q > 0.0 && q <= 1.0) {
-            return Err(format!("improvement threshold must be in (0, 1], got {q}"));
-        }
-        let w = self.planar.w;
-        if !(w.is_finite() && w > 0.0) {
-            return Err(format!("Eq. 5 weight w must be a positive number, got {w}"));
-        }
-        if self.rings == 0 {
-            return Err("improvement rings must be at least 1".into());
-        }
-        Ok(())
-    }
-}
-
-impl Default for ImproveOptions {
-    fn default() -> Self {
-        ImproveOptions {
-            enabled: false,
-            q_threshold: 0.5,
-            passes: 3,
-            rings: 2,
-            max_patches: None,
-            planar: crate::improve::Eq5Options::default(),
         }
     }
 }
@@ -205,7 +145,6 @@ impl RemeshOptions {
             }
         }
         self.sizes.validate()?;
-        self.improve.validate()?;
         let b = self.boundary.corner_angle;
         if !(b.is_finite() && b > 0.0 && b <= 180.0) {
             return Err(format!(
@@ -225,7 +164,7 @@ impl RemeshOptions {
 
 /// The research extension points, with the paper's methods as defaults. Built by name from
 /// the registries ([`crate::patches::STRATEGIES`], [`crate::param::PARAMETERIZERS`],
-/// [`crate::remesh2d::REMESHERS`]) or directly.
+/// [`crate::remesh2d::REMESHERS`], [`crate::improve::IMPROVERS`]) or directly.
 pub struct Stages {
     /// Sec. 3.2.
     pub patches: Box<dyn PatchStrategy>,
@@ -233,6 +172,20 @@ pub struct Stages {
     pub parameterizer: Box<dyn Parameterizer>,
     /// Sec. 3.3, planar remeshing.
     pub remesher: Box<dyn PlanarRemesher>,
+    /// Sec. 3.4, after the loop, in this order (default [`default_improvers`]).
+    pub improvers: Vec<Box<dyn Improver>>,
+}
+
+/// The improvers a run takes by default, in order (their registry names).
+pub const DEFAULT_IMPROVERS: &[&str] = &["surface"];
+
+/// The default improvers ([`DEFAULT_IMPROVERS`] from the registry, each with its default
+/// options; a test holds that every name builds).
+pub fn default_improvers() -> Vec<Box<dyn Improver>> {
+    DEFAULT_IMPROVERS
+        .iter()
+        .filter_map(|name| crate::improve::improver(name, Params::default()).ok())
+        .collect()
 }
 
 impl Default for Stages {
@@ -241,6 +194,7 @@ impl Default for Stages {
             patches: Box::new(ConePatches::default()),
             parameterizer: Box::new(SymmetricDirichlet::default()),
             remesher: Box::new(Lct::default()),
+            improvers: default_improvers(),
         }
     }
 }
@@ -263,9 +217,11 @@ impl Stages {
         }
     }
 
-    /// The stages of registry rows by name, each with its `KEY=VALUE` options. With a
-    /// `user_metric`, a patch strategy or planar remesher that has a `sizes` option gets
-    /// `sizes=true` unless it is given (absolute sizes; as [`Stages::for_user_metric`]).
+    /// The stages of registry rows by name, each with its `KEY=VALUE` options, and the
+    /// default improvers (replace [`Stages::improvers`] to change them, e.g. with
+    /// [`crate::improve::improver`]). With a `user_metric`, a patch strategy or planar
+    /// remesher that has a `sizes` option gets `sizes=true` unless it is given (absolute
+    /// sizes; as [`Stages::for_user_metric`]).
     pub fn from_registry(
         strategy: (&str, Params),
         parameterizer: (&str, Params),
@@ -297,16 +253,30 @@ impl Stages {
             patches: crate::patches::strategy(strategy.0, strategy.1)?,
             parameterizer: crate::param::parameterizer(parameterizer.0, parameterizer.1)?,
             remesher: crate::remesh2d::planar_remesher(remesher.0, remesher.1)?,
+            improvers: default_improvers(),
         })
+    }
+
+    /// The three stages of a patch, borrowed.
+    pub fn loop_stages(&self) -> crate::improve::LoopStages<'_> {
+        crate::improve::LoopStages {
+            patches: self.patches.as_ref(),
+            parameterizer: self.parameterizer.as_ref(),
+            remesher: self.remesher.as_ref(),
+        }
+    }
+
+    /// The improvers' names, in order.
+    pub fn improver_names(&self) -> Vec<String> {
+        self.improvers
+            .iter()
+            .map(|i| i.name().to_string())
+            .collect()
     }
 
     /// The names in the report: strategy, parameterizer, remesher.
     pub fn names(&self) -> [String; 3] {
-        [
-            self.patches.name().to_string(),
-            self.parameterizer.name().to_string(),
-            self.remesher.name().to_string(),
-        ]
+        self.loop_stages().names()
     }
 }
 
@@ -315,18 +285,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn improvement_options_no_run_can_use_are_named() {
-        let bad = |f: fn(&mut ImproveOptions)| {
-            let mut o = RemeshOptions::default();
-            f(&mut o.improve);
-            o.validate().expect_err("refused")
-        };
-        assert!(bad(|i| i.q_threshold = 0.0).contains("threshold"));
-        assert!(bad(|i| i.q_threshold = f64::NAN).contains("threshold"));
-        assert!(bad(|i| i.q_threshold = 1.5).contains("threshold"));
-        assert!(bad(|i| i.planar.w = -1.0).contains("weight w"));
-        assert!(bad(|i| i.planar.w = f64::INFINITY).contains("weight w"));
-        assert!(bad(|i| i.rings = 0).contains("rings"));
-        assert!(RemeshOptions::default().validate().is_ok());
+    fn the_default_improvers_are_registry_rows_in_order() {
+        let built: Vec<_> = default_improvers().iter().map(|i| i.name()).collect();
+        assert_eq!(built, DEFAULT_IMPROVERS);
+        assert_eq!(Stages::default().improver_names(), DEFAULT_IMPROVERS);
     }
 }

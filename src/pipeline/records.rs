@@ -28,9 +28,11 @@ pub struct StageTimes {
     pub fidelity: f64,
     /// Stitching.
     pub stitch: f64,
-    /// Working-mesh certificates after every patch, and the finishing passes (whose every
-    /// change is a certified candidate).
+    /// Working-mesh certificates after every patch and of the whole output.
     pub certify: f64,
+    /// The improvers after the loop (Sec. 3.4; Algorithm 2's patches also count in the stages
+    /// above).
+    pub improve: f64,
     /// Final self-intersection test.
     pub final_check: f64,
 }
@@ -183,6 +185,14 @@ pub enum Warning {
         /// of the output
         output_pairs: usize,
     },
+    /// An improver's budget ran out (its faces below target stay as they are; the output is
+    /// certified as any other).
+    ImproverBudget {
+        /// the improver
+        improver: String,
+        /// patches it made
+        patches: usize,
+    },
     /// The coarse-input profile ran ([`RemeshOptions::coarse_profile`]).
     CoarseProfile {
         /// `--coarse on` forced it (else the automatic rule chose it)
@@ -213,6 +223,11 @@ impl fmt::Display for Warning {
                 f,
                 "the patch budget ran out after {patches} patches: {unprocessed} face(s) were \
                  not reached and are kept as they were"
+            ),
+            Warning::ImproverBudget { improver, patches } => write!(
+                f,
+                "improver `{improver}` ran out of its budget after {patches} patches; the faces \
+                 it did not reach are kept as they were"
             ),
             Warning::InputSelfIntersects {
                 input_pairs,
@@ -282,24 +297,38 @@ pub struct AngleSummary {
     pub hist_min_angles: [usize; 18],
 }
 
-/// What Algorithm 2 (minimum-angle improvement, Sec. 3.4) did: the Table-1 row before and
-/// after (in the unscaled metric), its passes and patches, and its time.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+/// What the improvers after the loop (Sec. 3.4, [`super::Stages::improvers`]) did: the
+/// Table-1 row before the first and after the last (in the unscaled metric), each improver's
+/// record, and their time.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct ImprovementReport {
-    /// Before the step.
+    /// Before the first improver (Algorithm 1's output).
     pub before: AngleSummary,
-    /// After it.
+    /// After the last.
     pub after: AngleSummary,
-    /// Passes over the faces below the threshold.
-    pub passes: usize,
-    /// Patches tried.
-    pub patches: usize,
-    /// Patches whose candidate was refused because its smallest quality on the surface was
-    /// not above that of the faces it would replace (kept as they were).
-    pub rejected: usize,
-    /// `ImproveOptions::max_patches` ran out.
-    pub budget_exhausted: bool,
-    /// Wall time of the step.
+    /// One record per improver, in the order they ran.
+    pub steps: Vec<ImproverRecord>,
+    /// Wall time of all of them.
+    pub seconds: f64,
+}
+
+impl ImprovementReport {
+    /// The record of improver `name`, if it ran.
+    pub fn step(&self, name: &str) -> Option<&ImproverRecord> {
+        self.steps.iter().find(|s| s.name == name)
+    }
+}
+
+/// What one improver did.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ImproverRecord {
+    /// Its name (registry row).
+    pub name: String,
+    /// Its counts (flips, moves, passes, patches, rejected, budget).
+    pub counts: crate::improve::ImproverCounts,
+    /// The Table-1 row after it.
+    pub after: AngleSummary,
+    /// Its wall time (Algorithm 2's patches are also counted in the stage times).
     pub seconds: f64,
 }
 
@@ -334,10 +363,12 @@ pub struct Sizes {
 pub struct RemeshReport {
     /// Options used (after the coarse-input profile, when it ran).
     pub options: RemeshOptions,
-    /// Algorithm 2, when it ran.
+    /// The improvers after the loop (Sec. 3.4), when any ran.
     pub improvement: Option<ImprovementReport>,
     /// Strategy / parameterizer / remesher names.
     pub stages: [String; 3],
+    /// The improvers' names, in the order they ran.
+    pub improvers: Vec<String>,
     /// Mean metric edge length of the input (L_avg).
     pub l_avg: f64,
     /// Target metric edge length (L_tar).
@@ -361,9 +392,10 @@ pub struct RemeshReport {
     pub faces_out: usize,
     /// Output vertices.
     pub vertices_out: usize,
-    /// Edges flipped by the connectivity update after the loop ([`RemeshOptions::edge_flips`]).
+    /// Edges flipped by the improvers' connectivity updates on the surface
+    /// ([`crate::improve::SurfacePasses`]).
     pub edge_flips: usize,
-    /// Vertex moves of the vertex position update after the loop ([`RemeshOptions::relocate`]).
+    /// Vertex moves of their vertex position updates on the surface.
     pub vertex_moves: usize,
     /// Input vertices kept as corners ([`RemeshOptions::corner_defect`]); each is certified
     /// to be a vertex of the output at its input position.
