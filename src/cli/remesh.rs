@@ -140,19 +140,21 @@ pub struct RemeshArgs {
     #[arg(long, default_value_t = conemesh::boundary::BoundaryOptions::default().corner_angle)]
     pub boundary_corner_angle: f64,
     /// The improvers after the loop (Sec. 3.4), in order, by registry name, comma-separated
-    /// (`conemesh stages` lists them); `none` for none. Default: `surface` (the connectivity and
-    /// vertex position updates on the surface).
+    /// (`conemesh stages` lists them); `none` for none. Default: `surface,eq5` (the
+    /// connectivity and vertex position updates on the surface, then Algorithm 2).
     #[arg(long, value_name = "LIST")]
     pub improvers: Option<String>,
     /// An option of one improver, `NAME.KEY=VALUE` (e.g. `eq5.q=0.7`); repeatable.
     #[arg(long, value_name = "NAME.KEY=VALUE")]
     pub improver_opt: Vec<String>,
-    /// Add Algorithm 2 (minimum-angle improvement, improver `eq5`) after the default
-    /// improvers: cone patches around the faces whose metric quality is below `--improve-q`,
-    /// improved in the plane by the vertex position and connectivity updates of Eq. 5-6.
+    /// Run Algorithm 2 (minimum-angle improvement, improver `eq5`; in the default list): cone
+    /// patches around the faces whose metric quality is below `--improve-q` or whose smallest
+    /// angle is below 30°, improved in the plane by the vertex position and connectivity
+    /// updates of Eq. 5-6. Adds it to `--improvers` when that list lacks it.
     #[arg(long, conflicts_with = "no_improve")]
     pub improve: bool,
-    /// Leave Algorithm 2 (`eq5`) out of the improvers.
+    /// Leave Algorithm 2 (`eq5`) out of the improvers (Algorithm 1 and the surface passes
+    /// only).
     #[arg(long)]
     pub no_improve: bool,
     /// Algorithm 2: the quality below which a face is improved [0.5] (`eq5.q`).

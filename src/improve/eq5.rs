@@ -173,14 +173,18 @@ pub fn distortion_with(
     Some((f, [-(g1 + g2), g1, g2]))
 }
 
-/// The symmetric square root of an SPD 2×2 tensor.
+/// The symmetric square root of an SPD 2×2 tensor, in closed form: for `M` with
+/// `δ = √det M` and `τ = √(tr M + 2δ)`, `√M = (M + δ I) / τ` (Cayley–Hamilton: `S² − tr S·S +
+/// det S·I = 0` with `det S = δ`, `tr S = τ`). `None` when `M` is not SPD.
 fn sqrt_spd(m: &Matrix2<f64>) -> Option<Matrix2<f64>> {
-    let e = m.symmetric_eigen();
-    if e.eigenvalues.iter().any(|l| l.is_nan() || *l <= 0.0) {
+    let det = m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)];
+    let tr = m[(0, 0)] + m[(1, 1)];
+    if det.is_nan() || tr.is_nan() || det <= 0.0 || tr <= 0.0 {
         return None;
     }
-    let d = Matrix2::from_diagonal(&e.eigenvalues.map(f64::sqrt));
-    Some(e.eigenvectors * d * e.eigenvectors.transpose())
+    let delta = det.sqrt();
+    let tau = (tr + 2.0 * delta).sqrt();
+    Some((m + Matrix2::identity() * delta) / tau)
 }
 
 /// `log Σ exp(w·f)` over `fs`; `+∞` when one of them is (a degenerate or flipped triangle).
@@ -495,6 +499,23 @@ mod tests {
         fn metric(&self, _: &Point2<f64>) -> Matrix2<f64> {
             Matrix2::identity()
         }
+    }
+
+    #[test]
+    fn the_closed_form_square_root_squares_back_and_refuses_what_is_not_spd() {
+        for m in [
+            Matrix2::new(4.0, 0.0, 0.0, 9.0),
+            Matrix2::new(2.0, 0.7, 0.7, 0.5),
+            Matrix2::new(1e4, -3.0, -3.0, 1e-2),
+        ] {
+            let s = sqrt_spd(&m).expect("SPD");
+            assert!((s * s - m).norm() <= 1e-12 * m.norm(), "{m} {s}");
+            assert!((s - s.transpose()).norm() == 0.0);
+            assert!(s.determinant() > 0.0 && s.trace() > 0.0);
+        }
+        assert!(sqrt_spd(&Matrix2::new(1.0, 2.0, 2.0, 1.0)).is_none());
+        assert!(sqrt_spd(&Matrix2::new(-1.0, 0.0, 0.0, -1.0)).is_none());
+        assert!(sqrt_spd(&Matrix2::new(f64::NAN, 0.0, 0.0, 1.0)).is_none());
     }
 
     #[test]

@@ -71,8 +71,8 @@ pub trait ImproveRun {
     /// strategy seeds only at target faces; every patch is certified like one of Algorithm
     /// 1; its boundary chains are kept as they are). A certified candidate replaces its faces
     /// only when `accept(old, new)` holds for the bottoms of the faces it replaces and of the
-    /// candidate; otherwise the faces stay. At most `budget` patches. Ends: every patch marks
-    /// at least one target face done.
+    /// candidate; otherwise the faces stay. At most `budget` patches, and no more than the
+    /// run's own patch budget leaves. Ends: every patch marks at least one target face done.
     fn patch_pass(
         &mut self,
         stages: LoopStages<'_>,

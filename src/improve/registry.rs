@@ -31,6 +31,10 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
                 doc: "improve the faces whose metric quality is below this, in (0, 1] [0.5]",
             },
             OptionDoc {
+                name: "angle",
+                doc: "and those whose smallest angle is below this (degrees, [0, 60)) [30]",
+            },
+            OptionDoc {
                 name: "passes",
                 doc: "passes over the faces below q, each only if the last lowered their count [3]",
             },
@@ -62,6 +66,10 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
                 name: "steps",
                 doc: "gradient steps per vertex and round [4]",
             },
+            OptionDoc {
+                name: "line_search",
+                doc: "halvings of a step's line search [12]",
+            },
         ],
         build: eq5,
     },
@@ -87,6 +95,11 @@ fn eq5(p: &mut Params) -> Result<Box<dyn Improver>, BadValue> {
     let mut o = ImproveOptions::default();
     if let Some(q) = p.take_checked("q", "a number in (0, 1]", |q: f64| q > 0.0 && q <= 1.0)? {
         o.q_threshold = q;
+    }
+    if let Some(a) = p.take_checked("angle", "an angle in [0, 60) degrees", |a: f64| {
+        (0.0..60.0).contains(&a)
+    })? {
+        o.angle_threshold = a;
     }
     if let Some(n) = p.take("passes", "a number of passes")? {
         o.passes = n;
@@ -119,6 +132,9 @@ fn eq5(p: &mut Params) -> Result<Box<dyn Improver>, BadValue> {
     }
     if let Some(n) = p.take("steps", "a number of steps")? {
         o.planar.steps = n;
+    }
+    if let Some(n) = p.take("line_search", "a number of halvings")? {
+        o.planar.line_search = n;
     }
     Ok(Box::new(Algorithm2 { options: o }))
 }

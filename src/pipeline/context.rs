@@ -165,8 +165,10 @@ pub struct LoopState {
     pub faces_per_sweep: usize,
     /// The current sweep (1-based).
     pub sweep: usize,
-    /// Patches done.
+    /// Patches done (Algorithm 1's and the improvers').
     pub patches: usize,
+    /// Patches of Algorithm 1's loop (set when it ends).
+    pub loop_patches: usize,
     /// The patch budget ran out.
     pub budget_exhausted: bool,
     /// Times and certificate counts.
@@ -227,6 +229,7 @@ impl LoopState {
             faces_per_sweep: work.mesh.n_faces(),
             sweep: 1,
             patches: 0,
+            loop_patches: 0,
             budget_exhausted: false,
             counters: Counters::default(),
             records: Vec::new(),

@@ -82,8 +82,23 @@ fn patch_pass(
             state.work.mesh.n_faces()
         )));
     }
-    let ictx = ctx.for_improvement(stages);
     let mut pass = PatchPass::default();
+    // The run's patch budget bounds the improvers' patches too; once Algorithm 1 spent it,
+    // its unreached faces stay unprocessed (the report counts them) and no pass runs.
+    let run_left = ctx
+        .plan
+        .options
+        .max_patches
+        .map(|m| m.saturating_sub(state.patches));
+    if state.budget_exhausted || run_left == Some(0) {
+        pass.budget_exhausted = true;
+        return Ok(pass);
+    }
+    let budget = match (budget, run_left) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    };
+    let ictx = ctx.for_improvement(stages);
     state.work.processed = targets.iter().map(|t| !t).collect();
     while state.work.unprocessed() > 0 {
         if budget.is_some_and(|b| pass.patches >= b) {

@@ -24,7 +24,7 @@
 //! Files: `options.rs` (options and stages), `sizing.rs` (the [`Plan`] resolved before the
 //! loop), `context.rs` (what a run reads and the loop's state), `step.rs` (one patch with its
 //! retry ladder), `replace.rs` (stitching and the per-patch certificates), `improvement.rs`
-//! (the improvers after the loop, [`ImproveRun`]), `finish.rs` (the certificates of the
+//! (the improvers after the loop, [`crate::improve::ImproveRun`]), `finish.rs` (the certificates of the
 //! output, the report), `records.rs` (report types),
 //! `error.rs`, `debug.rs` (offending patches written out), `remesher.rs` (the whole job).
 
@@ -86,6 +86,7 @@ pub fn remesh(
         replace::replace_patch(&ctx, &mut state, outcome)?; // replace P, update M
         on_progress(state.progress(&ctx));
     }
+    state.loop_patches = state.patches;
     improvement::run(&ctx, &mut state, &mut rng)?; // Sec. 3.4, the improvers in order
     finish::certify_output(&ctx, &mut state)?;
     Ok(finish::into_result(&ctx, state))

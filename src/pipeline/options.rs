@@ -177,7 +177,7 @@ pub struct Stages {
 }
 
 /// The improvers a run takes by default, in order (their registry names).
-pub const DEFAULT_IMPROVERS: &[&str] = &["surface"];
+pub const DEFAULT_IMPROVERS: &[&str] = &["surface", "eq5"];
 
 /// The default improvers ([`DEFAULT_IMPROVERS`] from the registry, each with its default
 /// options; a test holds that every name builds).

@@ -373,8 +373,10 @@ pub struct RemeshReport {
     pub l_avg: f64,
     /// Target metric edge length (L_tar).
     pub l_tar: f64,
-    /// Number of patches.
+    /// Number of patches, Algorithm 1's and the improvers' (each certified).
     pub patches: usize,
+    /// Those of Algorithm 1's loop.
+    pub loop_patches: usize,
     /// The patch budget ([`RemeshOptions::max_patches`]) ran out before every face was
     /// processed.
     pub budget_exhausted: bool,
