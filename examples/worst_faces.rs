@@ -1,7 +1,8 @@
 //! The worst faces of a remesh, one by one: smallest angle and q in the metric, each corner's
 //! angle, whether its vertices are input corners (cone points kept by the corner rule) or on
 //! the boundary, and the edge lengths over L_tar. Diagnostics for Algorithm 2 (issue 18).
-//! `cargo run --release --example worst_faces -- MESH [N] [--improve]`.
+//! `cargo run --release --example worst_faces -- MESH [N] [--no-improve] [--metric M.sol]`
+//! (with a metric: L_tar = 1, as `bench --suite analytic`).
 
 use conemesh::mesh::Topology;
 use conemesh::pipeline::{RemeshOptions, Remesher, Stages};
@@ -10,7 +11,7 @@ use conemesh::quality::face_qualities;
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let Some(path) = a.get(1) else {
-        eprintln!("usage: worst_faces MESH [N] [--improve]");
+        eprintln!("usage: worst_faces MESH [N] [--no-improve] [--metric M.sol]");
         std::process::exit(2);
     };
     let n: usize = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(12);
@@ -21,22 +22,45 @@ fn main() {
             std::process::exit(2);
         }
     };
-    let mut stages = Stages::default();
-    if a.iter().any(|s| s == "--improve") {
-        stages
-            .improvers
-            .push(Box::new(conemesh::improve::Algorithm2::default()));
-    }
-    let out = match Remesher::new(RemeshOptions::default())
-        .with_stages(stages)
-        .run(&input)
+    let metric_path = a
+        .iter()
+        .position(|s| s == "--metric")
+        .and_then(|i| a.get(i + 1));
+    let metric = match metric_path
+        .map(|p| conemesh::io::sol::read_sol(std::path::Path::new(p), input.n_vertices()))
     {
-        Ok(o) => o,
-        Err(e) => {
-            eprintln!("{path}: {e}");
-            std::process::exit(1);
+        Some(Ok(m)) => Some(m),
+        Some(Err(e)) => {
+            eprintln!("{e}");
+            std::process::exit(2);
         }
+        None => None,
     };
+    let mut stages = match metric {
+        Some(_) => Stages::for_user_metric(),
+        None => Stages::default(),
+    };
+    if a.iter().any(|s| s == "--no-improve") {
+        stages.improvers.retain(|i| i.name() != "eq5");
+    }
+    let options = RemeshOptions {
+        target: match metric {
+            Some(_) => conemesh::pipeline::TargetLength::Absolute(1.0),
+            None => conemesh::pipeline::TargetLength::Factor(1.5),
+        },
+        ..RemeshOptions::default()
+    };
+    let out =
+        match Remesher::new(options)
+            .with_stages(stages)
+            .run_with(&input, metric.as_deref(), |_| {})
+        {
+            Ok(o) => o,
+            Err(e) => {
+                eprintln!("{path}: {e}");
+                std::process::exit(1);
+            }
+        };
     let unit = &out.unit;
     let l_tar = unit.report.l_tar;
     let ref_mesh = out.field.reference();

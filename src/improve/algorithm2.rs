@@ -18,10 +18,11 @@
 //! the count of faces below the threshold, and there are at most `passes` of them. Each pass
 //! takes one ring more around the bad faces than the last.
 
-use super::{Bottom, Eq5Improver, Eq5Options, ImproveRun, Improver, ImproverCounts};
+use super::{Eq5Improver, Eq5Options, ImproveRun, Improver, ImproverCounts};
 use super::{LoopStages, RunError};
 use crate::param::SymmetricDirichlet;
 use crate::patches::{ConeOptions, ConePatches};
+use crate::quality::TriangleQuality;
 use serde::Serialize;
 
 /// Options of Algorithm 2 (Sec. 3.4), with their defaults.
@@ -129,7 +130,8 @@ impl Improver for Algorithm2 {
             let stages = PassStages::new(o, o.rings + counts.passes);
             counts.passes += 1;
             let budget = o.max_patches.map(|m| m.saturating_sub(counts.patches));
-            let pass = run.patch_pass(stages.borrowed(), &bad, budget, &raises_the_bottom, rng)?;
+            let pass =
+                run.patch_pass(stages.borrowed(), &bad, budget, &better_at_the_bottom, rng)?;
             counts.patches += pass.patches;
             counts.rejected += pass.rejected;
             if pass.budget_exhausted {
@@ -174,13 +176,32 @@ impl PassStages {
 }
 
 /// The candidate is better at the bottom than the faces it replaces: neither its smallest
-/// metric quality nor its smallest angle is lower, and one of them is higher. (The planar
-/// updates lower the energy in the plane; lifted across a crease or a strongly curved part a
-/// move can still make a worse triangle on the surface, which is refused.)
-fn raises_the_bottom(old: Bottom, new: Bottom) -> bool {
-    new.q_min >= old.q_min
-        && new.theta_min >= old.theta_min
-        && (new.q_min > old.q_min || new.theta_min > old.theta_min)
+/// metric quality nor its smallest angle is lower (so no patch lowers the mesh's q_min or
+/// θ_min), and its smallest angles, sorted, are lexicographically higher (leximin: the first
+/// angle that differs is larger). The mean quality may fall: requiring it not to cost θ_min
+/// 3–6° on cow, decimated-knight, fertility and homer for q_avg changes below 0.001
+/// (paper-notes.md Sec. 3.4). Testing only
+/// the smallest angle refused every patch whose worst face sits on its boundary, which the
+/// planar updates cannot move, however much they raised the rest (86 % of the patches on
+/// cylinder-axial30). The planar updates lower the energy in the plane; lifted across a
+/// crease or a strongly curved part a move can still make a worse triangle on the surface,
+/// which is refused.
+fn better_at_the_bottom(old: &[TriangleQuality], new: &[TriangleQuality]) -> bool {
+    let q_min = |ts: &[TriangleQuality]| ts.iter().map(|t| t.q).fold(f64::INFINITY, f64::min);
+    let angles = |ts: &[TriangleQuality]| {
+        let mut a: Vec<f64> = ts.iter().map(|t| t.min_angle()).collect();
+        a.sort_by(f64::total_cmp);
+        a
+    };
+    let (a_old, a_new) = (angles(old), angles(new));
+    if new.len() != old.len() || new.is_empty() || q_min(new) < q_min(old) || a_new[0] < a_old[0] {
+        return false;
+    }
+    a_new
+        .iter()
+        .zip(&a_old)
+        .find(|(n, o)| n != o)
+        .is_some_and(|(n, o)| n > o)
 }
 
 #[cfg(test)]
@@ -204,12 +225,39 @@ mod tests {
     }
 
     #[test]
-    fn the_acceptance_test_wants_a_higher_bottom_and_nothing_lower() {
-        let b = |q_min, theta_min| Bottom { q_min, theta_min };
-        assert!(raises_the_bottom(b(0.3, 10.0), b(0.4, 10.0)));
-        assert!(raises_the_bottom(b(0.3, 10.0), b(0.3, 12.0)));
-        assert!(!raises_the_bottom(b(0.3, 10.0), b(0.3, 10.0)));
-        assert!(!raises_the_bottom(b(0.3, 10.0), b(0.5, 9.0)));
-        assert!(!raises_the_bottom(b(0.3, 10.0), b(0.2, 20.0)));
+    fn the_acceptance_test_is_leximin_on_angles_and_never_lowers_the_bottom() {
+        // Triangles with given smallest angle (the other two split the rest) and q.
+        let t = |a: f64, q: f64| TriangleQuality {
+            q,
+            angles: [a, 0.5 * (180.0 - a), 0.5 * (180.0 - a)],
+        };
+        let old = [t(10.0, 0.3), t(20.0, 0.5), t(40.0, 0.9)];
+        // The worst face unchanged (on the patch boundary), the next one raised: accepted.
+        assert!(better_at_the_bottom(
+            &old,
+            &[t(10.0, 0.3), t(30.0, 0.7), t(40.0, 0.9)]
+        ));
+        // The bottom raised.
+        assert!(better_at_the_bottom(
+            &old,
+            &[t(12.0, 0.3), t(15.0, 0.5), t(40.0, 0.9)]
+        ));
+        // Identical: refused (nothing gained).
+        assert!(!better_at_the_bottom(&old, &old));
+        // The smallest angle falls, or q_min falls, though the rest rises: refused.
+        assert!(!better_at_the_bottom(
+            &old,
+            &[t(9.0, 0.4), t(50.0, 0.9), t(50.0, 0.9)]
+        ));
+        assert!(!better_at_the_bottom(
+            &old,
+            &[t(10.0, 0.2), t(50.0, 0.9), t(50.0, 0.9)]
+        ));
+        // The second angle falls while the third rises: refused (leximin, not the sum).
+        assert!(!better_at_the_bottom(
+            &old,
+            &[t(10.0, 0.3), t(19.0, 0.5), t(60.0, 1.0)]
+        ));
+        assert!(!better_at_the_bottom(&old, &[]));
     }
 }

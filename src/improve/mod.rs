@@ -70,15 +70,16 @@ pub trait ImproveRun {
     /// Remesh the faces with `targets[f]` by patches of `stages`, as Algorithm 1 does (the
     /// strategy seeds only at target faces; every patch is certified like one of Algorithm
     /// 1; its boundary chains are kept as they are). A certified candidate replaces its faces
-    /// only when `accept(old, new)` holds for the bottoms of the faces it replaces and of the
-    /// candidate; otherwise the faces stay. At most `budget` patches, and no more than the
+    /// only when `accept(old, new)` holds for the qualities of the faces it replaces and of the
+    /// candidate's triangles on the surface (unscaled metric, as `conemesh eval`); otherwise the
+    /// faces stay. At most `budget` patches, and no more than the
     /// run's own patch budget leaves. Ends: every patch marks at least one target face done.
     fn patch_pass(
         &mut self,
         stages: LoopStages<'_>,
         targets: &[bool],
         budget: Option<usize>,
-        accept: &dyn Fn(Bottom, Bottom) -> bool,
+        accept: &dyn Fn(&[TriangleQuality], &[TriangleQuality]) -> bool,
         rng: &mut crate::Rng,
     ) -> Result<PatchPass, RunError>;
 }
@@ -103,16 +104,6 @@ impl LoopStages<'_> {
             self.remesher.name().to_string(),
         ]
     }
-}
-
-/// The bottom of a set of faces on the surface: its smallest metric quality and smallest angle
-/// (degrees), in the unscaled metric (what `conemesh eval` measures in).
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct Bottom {
-    /// Smallest q.
-    pub q_min: f64,
-    /// Smallest angle.
-    pub theta_min: f64,
 }
 
 /// What [`ImproveRun::patch_pass`] did.

@@ -8,7 +8,7 @@ use super::records::{AngleSummary, ImprovementReport, ImproverRecord};
 use super::step::PatchOutcome;
 use super::{replace, step};
 use crate::ids::FaceId;
-use crate::improve::{Bottom, ImproveRun, LoopStages, PatchPass, RunError, SurfaceContext};
+use crate::improve::{ImproveRun, LoopStages, PatchPass, RunError, SurfaceContext};
 use crate::metric::MetricField;
 use crate::quality::{face_qualities, stats_of, triangle_quality, TriangleQuality};
 use crate::stitch::{PatchVertex, Replacement, WorkingMesh};
@@ -57,7 +57,7 @@ impl ImproveRun for Host<'_> {
         stages: LoopStages<'_>,
         targets: &[bool],
         budget: Option<usize>,
-        accept: &dyn Fn(Bottom, Bottom) -> bool,
+        accept: &dyn Fn(&[TriangleQuality], &[TriangleQuality]) -> bool,
         rng: &mut crate::Rng,
     ) -> Result<PatchPass, RunError> {
         patch_pass(self.ctx, self.state, stages, targets, budget, accept, rng)
@@ -72,7 +72,7 @@ fn patch_pass(
     stages: LoopStages<'_>,
     targets: &[bool],
     budget: Option<usize>,
-    accept: &dyn Fn(Bottom, Bottom) -> bool,
+    accept: &dyn Fn(&[TriangleQuality], &[TriangleQuality]) -> bool,
     rng: &mut crate::Rng,
 ) -> Result<PatchPass, PipelineError> {
     if targets.len() != state.work.mesh.n_faces() {
@@ -112,8 +112,8 @@ fn patch_pass(
                 refined,
                 record,
             } if !accept(
-                bottom_of_faces(ctx, state, &faces),
-                bottom_of_candidate(ctx, state, &refined.replacement),
+                &qualities_of_faces(ctx, state, &faces),
+                &qualities_of_candidate(ctx, state, &refined.replacement),
             ) =>
             {
                 pass.rejected += 1;
@@ -181,31 +181,29 @@ pub fn run(
     Ok(())
 }
 
-fn bottom(qs: impl Iterator<Item = TriangleQuality>) -> Bottom {
-    qs.fold(
-        Bottom {
-            q_min: f64::INFINITY,
-            theta_min: f64::INFINITY,
-        },
-        |b, t| Bottom {
-            q_min: b.q_min.min(t.q),
-            theta_min: b.theta_min.min(t.min_angle()),
-        },
-    )
-}
-
-/// The bottom of working-mesh faces, in the metric at their vertices' reference locations.
-fn bottom_of_faces(ctx: &RunContext<'_>, state: &LoopState, faces: &[FaceId]) -> Bottom {
+/// The qualities of working-mesh faces, in the metric at their vertices' reference locations.
+fn qualities_of_faces(
+    ctx: &RunContext<'_>,
+    state: &LoopState,
+    faces: &[FaceId],
+) -> Vec<TriangleQuality> {
     let work = &state.work;
-    bottom(faces.iter().map(|&f| {
-        let t = work.mesh.face(f);
-        let m = t.map(|v| ctx.quality_field.eval_at(&work.locations[v.idx()]));
-        triangle_quality(work.mesh.face_points(f), &((m[0] + m[1] + m[2]) / 3.0))
-    }))
+    faces
+        .iter()
+        .map(|&f| {
+            let t = work.mesh.face(f);
+            let m = t.map(|v| ctx.quality_field.eval_at(&work.locations[v.idx()]));
+            triangle_quality(work.mesh.face_points(f), &((m[0] + m[1] + m[2]) / 3.0))
+        })
+        .collect()
 }
 
-/// The bottom of a candidate's triangles, measured as [`bottom_of_faces`] would after it.
-fn bottom_of_candidate(ctx: &RunContext<'_>, state: &LoopState, candidate: &Replacement) -> Bottom {
+/// The qualities of a candidate's triangles, measured as [`qualities_of_faces`] would after it.
+fn qualities_of_candidate(
+    ctx: &RunContext<'_>,
+    state: &LoopState,
+    candidate: &Replacement,
+) -> Vec<TriangleQuality> {
     let work = &state.work;
     let vertex = |v: PatchVertex| match v {
         PatchVertex::Existing(u) => (
@@ -218,10 +216,14 @@ fn bottom_of_candidate(ctx: &RunContext<'_>, state: &LoopState, candidate: &Repl
                 .eval_at(&candidate.new_locations[i as usize]),
         ),
     };
-    bottom(candidate.triangles.iter().map(|t| {
-        let c = t.map(vertex);
-        triangle_quality(c.map(|c| c.0), &((c[0].1 + c[1].1 + c[2].1) / 3.0))
-    }))
+    candidate
+        .triangles
+        .iter()
+        .map(|t| {
+            let c = t.map(vertex);
+            triangle_quality(c.map(|c| c.0), &((c[0].1 + c[1].1 + c[2].1) / 3.0))
+        })
+        .collect()
 }
 
 /// Per-face quality of the working mesh in the unscaled metric (what `eval` measures).
