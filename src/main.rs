@@ -27,12 +27,14 @@ enum Command {
     /// Convert a mesh between formats (by file extension).
     Convert(cli::convert::ConvertArgs),
     /// Score a remeshed surface against its input (Table-1 quality, fidelity, validity).
+    #[command(allow_negative_numbers = true)]
     Eval(cli::eval::EvalArgs),
     /// Cover a mesh with patches (no remeshing) and report them.
     Patches(cli::patches::PatchesArgs),
     /// Parameterize a disk-topology mesh bijectively into the plane.
     Param(cli::param::ParamArgs),
     /// Remesh a surface anisotropically (Algorithm 1).
+    #[command(allow_negative_numbers = true)]
     Remesh(cli::remesh::RemeshArgs),
     /// List the registered patch strategies, parameterizers and planar remeshers.
     Stages(cli::stages::StagesArgs),

@@ -50,6 +50,14 @@ pub struct EvalArgs {
 /// Run `conemesh eval`.
 pub fn run(args: EvalArgs) -> anyhow::Result<ExitCode> {
     let t0 = std::time::Instant::now();
+    // Before reading anything: the count alone decides.
+    if args.samples > conemesh::quality::MAX_SAMPLES {
+        anyhow::bail!(
+            "--samples {}: at most {} random samples per surface are taken",
+            args.samples,
+            conemesh::quality::MAX_SAMPLES
+        );
+    }
     let input = conemesh::io::read_mesh(&args.input)
         .with_context(|| format!("reading input {}", args.input.display()))?
         .mesh;

@@ -178,6 +178,7 @@ pub struct RemeshArgs {
 /// Run `conemesh remesh`.
 pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     let t_start = Instant::now();
+    check_output_paths(&args)?;
     let (name, mesh) = match &args.mesh {
         Some(p) => {
             let loaded =
@@ -211,7 +212,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         bar.set_message(format!("{} patches", p.patches));
     });
     bar.finish_and_clear();
-    let out = result?;
+    let out = result.with_context(|| format!("remeshing {name}"))?;
     let elapsed = t_start.elapsed().as_secs_f64();
     // The yardstick, independent of the remesher: `conemesh eval` on the output.
     let eval_opts = EvalOptions {
@@ -312,6 +313,57 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Every output path, checked before any work (issue 20): each file's folder exists, no file
+/// output is a directory, `--plots` is not a regular file, and no two outputs (nor an output
+/// and the input or the metric) are the same path.
+fn check_output_paths(args: &RemeshArgs) -> anyhow::Result<()> {
+    let files: Vec<(&str, &PathBuf)> = [
+        Some(("-o", &args.output)),
+        args.report.as_ref().map(|p| ("--report", p)),
+        args.write_metric.as_ref().map(|p| ("--write-metric", p)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for (flag, p) in &files {
+        if p.is_dir() {
+            anyhow::bail!("{flag} {}: is a directory, not a file", p.display());
+        }
+        let parent = p.parent().filter(|d| !d.as_os_str().is_empty());
+        if let Some(d) = parent.filter(|d| !d.is_dir()) {
+            anyhow::bail!(
+                "{flag} {}: folder {} does not exist",
+                p.display(),
+                d.display()
+            );
+        }
+    }
+    if let Some(d) = args.plots.as_ref().filter(|d| d.exists() && !d.is_dir()) {
+        anyhow::bail!("--plots {}: is a file, not a folder", d.display());
+    }
+    // Compared as absolute paths with `.` and `..` resolved where the file exists.
+    let key = |p: &PathBuf| {
+        std::fs::canonicalize(p)
+            .or_else(|_| std::path::absolute(p))
+            .unwrap_or_else(|_| p.clone())
+    };
+    let inputs: Vec<(&str, &PathBuf)> = [
+        args.mesh.as_ref().map(|p| ("the input", p)),
+        args.metric.as_ref().map(|p| ("--metric", p)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for (i, (flag, p)) in files.iter().enumerate() {
+        for (other, q) in files[..i].iter().chain(&inputs) {
+            if key(p) == key(q) {
+                anyhow::bail!("{flag} {} is the same path as {other}", p.display());
+            }
+        }
+    }
+    Ok(())
 }
 
 /// `--ltar` or `--ltar-factor`. A metric length is the same in file units and in unit space

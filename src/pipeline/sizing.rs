@@ -60,8 +60,22 @@ impl Plan {
             TargetLength::Absolute(l) => l,
         };
         if !(l_tar.is_finite() && l_tar > 0.0) {
+            // Name where the value came from: the option, or the input's own edge lengths
+            // (a mesh whose size over- or underflows, or a metric that vanishes).
+            let why = match options.target {
+                TargetLength::Factor(f) if f.is_finite() && f > 0.0 => format!(
+                    "L_tar = {f} × L_avg, and the input's mean metric edge length L_avg is {l_avg} \
+                     (a mesh too large or too small for its metric, or a vanishing metric)"
+                ),
+                TargetLength::Factor(f) => {
+                    format!("the target factor (--ltar-factor) {f} is not a positive number")
+                }
+                TargetLength::Absolute(l) => {
+                    format!("the absolute target (--ltar) {l} is not a positive number")
+                }
+            };
             return Err(PipelineError::Input(format!(
-                "target edge length {l_tar} is not a positive finite number (L_avg = {l_avg})"
+                "target edge length {l_tar} is not a positive finite number: {why}"
             )));
         }
         let sized =

@@ -136,7 +136,15 @@ pub enum EvalError {
     /// The metric (a user metric that is not SPD on the input, or the curvature estimate).
     #[error(transparent)]
     Metric(#[from] crate::metric::MetricError),
+    /// More random samples than [`MAX_SAMPLES`] were asked for (refused before any
+    /// allocation).
+    #[error("{0} random samples per surface asked for; at most {MAX_SAMPLES} are taken")]
+    TooManySamples(usize),
 }
+
+/// The most random samples per surface [`evaluate`] takes (each costs 24 bytes and a
+/// closest-point query; 10⁸ is already minutes of work).
+pub const MAX_SAMPLES: usize = 100_000_000;
 
 /// Score `output` against `input` (both in file units).
 ///
@@ -148,6 +156,9 @@ pub fn evaluate(
     input_metric: Option<&[Matrix3<f64>]>,
     opts: &EvalOptions,
 ) -> Result<EvalReport, EvalError> {
+    if opts.samples > MAX_SAMPLES {
+        return Err(EvalError::TooManySamples(opts.samples));
+    }
     let norm = Normalization::of(input);
     let (unit_in, unit_out) = (norm.apply(input), norm.apply(output));
 

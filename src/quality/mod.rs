@@ -12,7 +12,9 @@ mod distance;
 mod eval;
 
 pub use distance::{approximation_error, flips, Distance};
-pub use eval::{evaluate, EvalError, EvalOptions, EvalReport, EvalTimings, MeshSize, TargetLength};
+pub use eval::{
+    evaluate, EvalError, EvalOptions, EvalReport, EvalTimings, MeshSize, TargetLength, MAX_SAMPLES,
+};
 
 use crate::ids::{EdgeKey, VertexId};
 use crate::mesh::TriMesh;
