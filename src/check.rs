@@ -121,9 +121,12 @@ pub fn check_mesh(mesh: &TriMesh, opts: &CheckOptions) -> CheckReport {
     let nm_edges: Vec<EdgeKey> = topo.non_manifold_edges().iter().map(|e| e.0).collect();
     let nm_verts = invariants::non_manifold_vertices(mesh, &topo);
     let inconsistent = topo.inconsistent_edges();
-    let degenerate = invariants::degenerate_faces(mesh);
+    // Exact verdicts at any finite scale: the predicates run on the mesh scaled by a power of
+    // two (exact), where their products neither underflow nor overflow.
+    let scaled = mesh.scaled_by_power_of_two();
+    let degenerate = invariants::degenerate_faces(&scaled);
     let self_intersections = opts.self_intersections.then(|| {
-        let pairs: Vec<FacePair> = invariants::self_intersections(mesh)
+        let pairs: Vec<FacePair> = invariants::self_intersections(&scaled)
             .into_iter()
             .filter(|(f, g)| f != g)
             .map(|(f, g)| FacePair(f, g))
@@ -236,6 +239,60 @@ mod tests {
     use super::*;
     use crate::mesh::generators;
     use nalgebra::Point3;
+
+    /// Issue 20: a valid icosphere of radius 1e-300 or 1e300 was reported with degenerate
+    /// faces and self-intersections (the predicates' products under- or overflowed); a
+    /// pushed-through vertex is still found at those scales.
+    #[test]
+    fn verdicts_are_exact_at_extreme_scales() {
+        for scale in [1e-300, 1e-150, 1.0, 1e150, 1e300] {
+            let mut m = generators::icosphere(1.0, 2);
+            for p in &mut m.positions {
+                *p = Point3::from(p.coords * scale);
+            }
+            let r = check_mesh(&m, &CheckOptions::default());
+            assert!(r.valid, "radius {scale}: {r:?}");
+            assert_eq!(r.degenerate_faces, 0, "radius {scale}");
+            m.positions[0] = Point3::from(-m.positions[0].coords * 1.5);
+            let r = check_mesh(&m, &CheckOptions::default());
+            assert!(
+                r.self_intersections.is_some_and(|s| s.pairs > 0),
+                "radius {scale}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_power_of_two_scaling_is_exact_and_lands_in_one_to_two() {
+        for scale in [1e-300, 0.75, 1.0, 2.0, 5e300] {
+            let m = TriMesh::from_indices(
+                vec![
+                    Point3::new(0.0, 0.0, 0.0),
+                    Point3::new(scale, 0.1 * scale, 0.0),
+                    Point3::new(-0.3 * scale, scale * 0.9, 0.25 * scale),
+                ],
+                &[[0, 1, 2]],
+            )
+            .unwrap();
+            let s = m.scaled_by_power_of_two();
+            let max = s
+                .positions
+                .iter()
+                .flat_map(|p| p.iter().map(|x| x.abs()))
+                .fold(0.0f64, f64::max);
+            assert!((1.0..2.0).contains(&max), "{scale}: {max}");
+            // One factor for every coordinate, and it is a power of two.
+            let f = s.positions[1].x / m.positions[1].x;
+            assert_eq!(f.to_bits() & ((1u64 << 52) - 1), 0, "{scale}: {f}");
+            for (a, b) in m.positions.iter().zip(&s.positions) {
+                for k in 0..3 {
+                    if a[k].abs() >= f64::MIN_POSITIVE {
+                        assert_eq!(b[k], a[k] * f, "{scale}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn clean_torus_is_valid_genus_one() {

@@ -208,6 +208,58 @@ fn big_endian_binary_is_read() -> R {
     Ok(())
 }
 
+/// Issue 20: a tensor that is positive definite but conditioned beyond what the field takes is
+/// not called indefinite, and the CLI names the .sol file and the vertex.
+#[test]
+fn an_ill_conditioned_tensor_is_named_as_such_with_its_file() -> R {
+    let dir = tempfile::tempdir()?;
+    let mesh = conemesh::TriMesh::new(
+        vec![
+            nalgebra::Point3::new(0.0, 0.0, 0.0),
+            nalgebra::Point3::new(1.0, 0.0, 0.0),
+            nalgebra::Point3::new(0.0, 1.0, 0.0),
+            nalgebra::Point3::new(1.0, 1.0, 0.1),
+        ],
+        vec![
+            [
+                conemesh::VertexId(0),
+                conemesh::VertexId(1),
+                conemesh::VertexId(2),
+            ],
+            [
+                conemesh::VertexId(1),
+                conemesh::VertexId(3),
+                conemesh::VertexId(2),
+            ],
+        ],
+    )?;
+    let input = dir.path().join("q.obj");
+    conemesh::io::write_mesh(&input, &mesh)?;
+    let mut ms = vec![nalgebra::Matrix3::identity(); 4];
+    ms[3][(0, 0)] = 1e12;
+    let sol = dir.path().join("skewed.sol");
+    write_sol(&sol, &ms, false)?;
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_conemesh"))
+        .arg("remesh")
+        .arg(&input)
+        .arg("--metric")
+        .arg(&sol)
+        .arg("-o")
+        .arg(dir.path().join("out.obj"))
+        .arg("--quiet")
+        .output()?;
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("skewed.sol") && err.contains("vertex v3"),
+        "{err}"
+    );
+    assert!(err.contains("conditioned beyond"), "{err}");
+    assert!(!err.contains("not positive definite"), "{err}");
+    assert!(!dir.path().join("out.obj").exists());
+    Ok(())
+}
+
 #[test]
 fn non_spd_tensor_from_a_sol_file_is_rejected_by_the_field() -> R {
     let dir = tempfile::tempdir()?;

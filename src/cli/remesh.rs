@@ -212,7 +212,10 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         bar.set_message(format!("{} patches", p.patches));
     });
     bar.finish_and_clear();
-    let out = result.with_context(|| format!("remeshing {name}"))?;
+    let out = result.with_context(|| match &args.metric {
+        Some(m) => format!("remeshing {name} with metric {}", m.display()),
+        None => format!("remeshing {name}"),
+    })?;
     let elapsed = t_start.elapsed().as_secs_f64();
     // The yardstick, independent of the remesher: `conemesh eval` on the output.
     let eval_opts = EvalOptions {

@@ -312,8 +312,10 @@ pub fn read_mesh_bytes(bytes: &[u8], format: Format, path: &str) -> Result<Loade
     match format {
         Format::Obj => obj::read(bytes, path),
         Format::Off => off::read(bytes, path),
-        Format::Ply => ply::read(bytes, path),
-        Format::Stl => stl::read(bytes, path),
+        // A byte-order mark before the text formats' magic words (editors on Windows write
+        // one); the other formats skip it in `text::as_text`.
+        Format::Ply => ply::read(text::strip_bom_before(bytes, b"ply"), path),
+        Format::Stl => stl::read(text::strip_bom_before(bytes, b"solid"), path),
         Format::Medit => medit::read(bytes, path),
     }
 }

@@ -70,7 +70,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let mut corner_vt: Option<Vec<(usize, i64)>> = Some(Vec::new());
     let mut unknown: Vec<String> = Vec::new();
     let mut any = false;
-    for (i, raw) in text.lines().enumerate() {
+    for (i, raw) in super::text::lines(text).enumerate() {
         let l = i + 1;
         let s = raw.split('#').next().unwrap_or("");
         let mut t = s.split_ascii_whitespace();
@@ -133,7 +133,9 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
                     match parts.next().filter(|s| !s.is_empty()) {
                         Some(vt) => {
                             let wt = int(vt, l, path, F)?;
-                            match (resolve(wt, vts.len()), corner_vt.as_mut()) {
+                            // Like vertex indices, a texture index must name a `vt` above it.
+                            let r = resolve(wt, vts.len()).filter(|&r| (r as usize) < vts.len());
+                            match (r, corner_vt.as_mut()) {
                                 (Some(r), Some(c)) => c.push((v as usize, r)),
                                 (None, _) => {
                                     return Err(IoError::Parse {

@@ -12,8 +12,7 @@ const F: &str = "OFF";
 
 pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let text = as_text(bytes, path, F)?;
-    let mut lines = text
-        .lines()
+    let mut lines = super::text::lines(text)
         .enumerate()
         .map(|(i, l)| (i + 1, l.split('#').next().unwrap_or("").trim()))
         .filter(|(_, l)| !l.is_empty());

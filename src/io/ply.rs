@@ -249,10 +249,10 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
     }
     let first_end = bytes
         .iter()
-        .position(|&b| b == b'\n')
+        .position(|&b| b == b'\n' || b == b'\r')
         .unwrap_or(bytes.len());
     let first = &bytes[..first_end];
-    if first.strip_suffix(b"\r").unwrap_or(first) != b"ply" {
+    if first != b"ply" {
         return Err(IoError::BadMagic {
             path: path.to_string(),
             format: F,
@@ -271,16 +271,17 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
                 message: "header has no `end_header` line".into(),
             });
         }
+        // A header line ends with LF, CRLF or a lone CR.
         let end = bytes[pos..]
             .iter()
-            .position(|&b| b == b'\n')
+            .position(|&b| b == b'\n' || b == b'\r')
             .map_or(bytes.len(), |k| pos + k);
         line_no += 1;
         let raw = &bytes[pos..end];
-        let text = std::str::from_utf8(raw)
-            .map_err(|_| err(line_no, "header line is not text".into()))?
-            .trim_end_matches('\r');
-        pos = (end + 1).min(bytes.len());
+        let text =
+            std::str::from_utf8(raw).map_err(|_| err(line_no, "header line is not text".into()))?;
+        let crlf = bytes.get(end) == Some(&b'\r') && bytes.get(end + 1) == Some(&b'\n');
+        pos = (end + if crlf { 2 } else { 1 }).min(bytes.len());
         if text.trim() == "end_header" {
             break pos;
         }

@@ -185,7 +185,8 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
         detail: format!("neither binary nor UTF-8 text ({e})"),
     })?;
     // Tokens with their 1-based line; '#' starts a comment.
-    let mut tokens = text.lines().enumerate().flat_map(|(i, l)| {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut tokens = super::text::lines(text).enumerate().flat_map(|(i, l)| {
         let l = l.split('#').next().unwrap_or("");
         l.split_whitespace().map(move |t| (i + 1, t))
     });

@@ -446,6 +446,60 @@ fn failed_write_leaves_no_file() {
     assert!(left.is_empty(), "{left:?}");
 }
 
+/// Issue 20: a byte-order mark before ASCII STL and PLY (it was only skipped in OBJ, OFF and
+/// .mesh), and files whose lines end with a lone CR (they read as one line: "empty OBJ file").
+#[test]
+fn a_byte_order_mark_and_cr_only_line_ends_read_in_every_text_format() -> Result<(), IoError> {
+    let stl = "\u{feff}solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n\
+               vertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+    let ply = "\u{feff}ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n\
+               property float y\nproperty float z\nelement face 1\n\
+               property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    for (text, f) in [(stl, Format::Stl), (ply, Format::Ply)] {
+        let m = rd(text, f)?;
+        assert_eq!((m.mesh.n_vertices(), m.mesh.n_faces()), (3, 1), "{f:?}");
+    }
+    // Bytes that only look like a mark in a binary STL header are not stripped.
+    let mut bin = b"\xEF\xBB\xBFbinary header".to_vec();
+    bin.resize(80, b' ');
+    bin.extend_from_slice(&0u32.to_le_bytes());
+    assert!(
+        matches!(
+            read_mesh_bytes(&bin, Format::Stl, "t"),
+            Err(IoError::NoFaces { .. }) | Err(IoError::Empty { .. })
+        ),
+        "{:?}",
+        read_mesh_bytes(&bin, Format::Stl, "t").map(|m| m.mesh.n_faces())
+    );
+    let cr = |s: &str| s.replace('\n', "\r");
+    for (text, f) in [
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Format::Obj),
+        ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", Format::Off),
+        (stl, Format::Stl),
+        (ply, Format::Ply),
+    ] {
+        let m = rd(&cr(text), f)?;
+        assert_eq!((m.mesh.n_vertices(), m.mesh.n_faces()), (3, 1), "{f:?}");
+    }
+    // Line numbers count lone CRs and CRLFs alike.
+    let err = rd("v 0 0 0\r\nv 1 0 0\rv 0 1 0\r\nf 1 2 9\r", Format::Obj).unwrap_err();
+    assert!(err.to_string().contains("t:4"), "{err}");
+    Ok(())
+}
+
+/// Issue 20: a texture index beyond the `vt` lines is refused like a vertex index (it used to
+/// pass, and the texture coordinates were dropped as "seams").
+#[test]
+fn an_obj_texture_index_out_of_range_is_refused_naming_it() {
+    let err = rd(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/5 3/1\n",
+        Format::Obj,
+    )
+    .unwrap_err();
+    let s = err.to_string();
+    assert!(s.contains("texture index 5") && s.contains("t:5"), "{s}");
+}
+
 #[test]
 fn utf8_byte_order_mark_is_skipped() -> Result<(), IoError> {
     let m = rd("\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Format::Obj)?;

@@ -26,9 +26,38 @@ pub(crate) fn as_text<'a>(
     })
 }
 
+/// The lines of `text`, ended by `\n`, `\r\n` or a lone `\r` (classic Mac OS files:
+/// `str::lines` would read such a file as one line), without their line ends.
+pub(crate) fn lines(text: &str) -> impl Iterator<Item = &str> {
+    let mut rest = Some(text);
+    std::iter::from_fn(move || {
+        let s = rest?;
+        match s.find(['\n', '\r']) {
+            Some(i) => {
+                let skip = if s[i..].starts_with("\r\n") { 2 } else { 1 };
+                rest = Some(&s[i + skip..]).filter(|r| !r.is_empty());
+                Some(&s[..i])
+            }
+            None => {
+                rest = None;
+                Some(s)
+            }
+        }
+    })
+}
+
+/// A UTF-8 byte-order mark at the start of `bytes` when `magic` follows it (so a binary
+/// file that happens to start with those bytes is left alone): the bytes after it.
+pub(crate) fn strip_bom_before<'a>(bytes: &'a [u8], magic: &[u8]) -> &'a [u8] {
+    match bytes.strip_prefix(b"\xEF\xBB\xBF") {
+        Some(rest) if rest.starts_with(magic) => rest,
+        _ => bytes,
+    }
+}
+
 /// Whitespace-separated tokens with their 1-based line, `#` comments removed.
 pub(crate) struct Tokens<'a> {
-    lines: std::iter::Enumerate<std::str::Lines<'a>>,
+    lines: Box<dyn Iterator<Item = (usize, &'a str)> + 'a>,
     cur: std::str::SplitAsciiWhitespace<'a>,
     line: usize,
     /// Line of the last token returned (or of the end of the file).
@@ -44,7 +73,7 @@ impl<'a> Tokens<'a> {
     /// Tokens of `text` whose first line is line `first` of the file.
     pub(crate) fn starting_at(text: &'a str, first: usize) -> Self {
         Tokens {
-            lines: text.lines().enumerate(),
+            lines: Box::new(lines(text).enumerate()),
             cur: "".split_ascii_whitespace(),
             line: first.saturating_sub(1),
             last_line: first.saturating_sub(1),

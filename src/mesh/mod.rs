@@ -284,6 +284,36 @@ impl TriMesh {
         bbox_of(self.positions.iter().copied())
     }
 
+    /// The mesh scaled by a power of two so that its largest absolute coordinate lies in
+    /// `[1, 2)` (itself when it has no non-zero coordinate). Multiplying by a power of two is
+    /// exact for every coordinate that stays a normal float, so every orientation and
+    /// intersection verdict on the scaled mesh is the verdict on this one; at extreme scales
+    /// (1e±300) the predicates' products would underflow or overflow on the mesh as it is.
+    pub fn scaled_by_power_of_two(&self) -> TriMesh {
+        let max = self
+            .positions
+            .iter()
+            .flat_map(|p| p.iter().map(|x| x.abs()))
+            .fold(0.0f64, f64::max);
+        if !(max.is_finite() && max > 0.0) {
+            return self.clone();
+        }
+        // floor(log2(max)) from the float's exponent bits (exact, unlike log2 near powers of
+        // two); subnormal maxima are first brought into the normal range.
+        let (max, pre) = match max < f64::MIN_POSITIVE {
+            true => (max * 2f64.powi(64), 64),
+            false => (max, 0),
+        };
+        let e = ((max.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+        let k = -(e - pre);
+        // 2^k may not be representable at once (|k| up to 1074): apply it in two halves.
+        let (a, b) = (2f64.powi(k / 2), 2f64.powi(k - k / 2));
+        TriMesh {
+            positions: self.positions.iter().map(|p| (p * a) * b).collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+
     /// Length of the bounding-box diagonal (0 for an empty mesh).
     pub fn bbox_diagonal(&self) -> f64 {
         self.bbox().map(|(lo, hi)| (hi - lo).norm()).unwrap_or(0.0)

@@ -82,13 +82,23 @@ pub fn validate_vertex_metric(
         let be = b.symmetric_eigenvalues();
         let bmin = be.min();
         if !(bmin > 0.0 && bmin > TANGENT_PD_RELATIVE_TOLERANCE * lmax) {
-            return Err(MetricError::NotSpd {
-                vertex,
-                detail: format!(
+            // Positive but beyond the conditioning the predicates and the planar stage can
+            // carry is not the same error as indefinite: say which.
+            let detail = match bmin > 0.0 {
+                true => format!(
+                    "positive definite on the tangent plane but conditioned beyond {:e}:1 \
+                     (eigenvalues there {:e}, {:e}; sizes differing by more than {:e} at one point)",
+                    1.0 / TANGENT_PD_RELATIVE_TOLERANCE,
+                    be[0],
+                    be[1],
+                    TANGENT_PD_RELATIVE_TOLERANCE.sqrt().recip()
+                ),
+                false => format!(
                     "not positive definite on the tangent plane (eigenvalues there {:e}, {:e})",
                     be[0], be[1]
                 ),
-            });
+            };
+            return Err(MetricError::NotSpd { vertex, detail });
         }
     }
     Ok(())

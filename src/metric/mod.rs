@@ -25,8 +25,9 @@ use thiserror::Error;
 /// Errors of the metric stage.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum MetricError {
-    /// A tensor is not symmetric positive (semi-)definite on the tangent plane.
-    #[error("metric at vertex v{vertex} is not SPD on the tangent plane: {detail}")]
+    /// A tensor is not symmetric positive (semi-)definite on the tangent plane, or is so
+    /// badly conditioned there that it cannot be used (`detail` says which).
+    #[error("metric at vertex v{vertex} cannot be used: {detail}")]
     NotSpd {
         /// vertex index
         vertex: usize,

@@ -157,7 +157,9 @@ impl Remesher {
         // The certificates were taken in unit space; mapping back to file units rounds the new
         // vertices, so the mesh that is returned is certified again (exact): no degenerate
         // face, and no self-intersection where the unit-space output had none.
-        invariants::certify_no_degenerate_faces(&mesh).map_err(PipelineError::FileUnits)?;
+        // On the mesh scaled by a power of two (exact), so the verdicts hold at any scale.
+        let scaled = mesh.scaled_by_power_of_two();
+        invariants::certify_no_degenerate_faces(&scaled).map_err(PipelineError::FileUnits)?;
         invariants::certify_boundary_on_curves(
             &unit.curves,
             &file_mesh,
@@ -167,7 +169,7 @@ impl Remesher {
         )
         .map_err(PipelineError::FileUnits)?;
         if unit.report.certificate.no_self_intersections == 1 {
-            invariants::certify_no_self_intersections(&mesh).map_err(PipelineError::FileUnits)?;
+            invariants::certify_no_self_intersections(&scaled).map_err(PipelineError::FileUnits)?;
         }
         Ok(Remeshed {
             mesh,

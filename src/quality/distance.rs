@@ -148,8 +148,8 @@ fn one_side(pts: &[Point3<f64>], n_random: usize, target: &SurfaceProjector) -> 
 /// Each surface is sampled at all its vertices used by a face, plus `min_samples` area-weighted random
 /// points (seeded by `rng`; first `a`'s, then `b`'s), and every sample is measured to the
 /// other surface by the exact point-triangle distance (parry BVH); then the faces of the
-/// largest random samples of each side are sampled again densely ([`REFINE_FACES`] faces ×
-/// [`REFINE_SAMPLES`] points, drawn after all the others), so a peak in a small region is
+/// largest random samples of each side are sampled again densely (32 faces × 512 points,
+/// drawn after all the others), so a peak in a small region is
 /// not missed. Hausdorff is the larger
 /// of the two one-sided maxima; RMS is over the random samples of both sides; relative
 /// values divide by the bounding-box diagonal of `a`. The distance queries run in parallel
