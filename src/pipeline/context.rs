@@ -29,8 +29,9 @@ pub struct RunContext<'a> {
     pub stages: LoopStages<'a>,
     /// The improvers after the loop, in order.
     pub improvers: &'a [Box<dyn Improver>],
-    /// The flip certificate against the reference.
-    pub flip_test: FlipTest,
+    /// The flip certificate against the reference (shared with the contexts of Algorithm 2's
+    /// passes, which would otherwise index the reference again).
+    pub flip_test: std::sync::Arc<FlipTest>,
     /// Area-weighted vertex normals of the reference (the fidelity control's).
     pub ref_normals: Vec<Vector3<f64>>,
     /// Self-intersecting face pairs of the input (0 when not checked).
@@ -85,7 +86,7 @@ impl<'a> RunContext<'a> {
             plan,
             stages: stages.loop_stages(),
             improvers: &stages.improvers,
-            flip_test: FlipTest::new(reference),
+            flip_test: std::sync::Arc::new(FlipTest::new(reference)),
             ref_normals: reference.area_weighted_normals(),
             input_pairs,
             embedded_input: o.check_self_intersections && input_pairs == 0,
@@ -105,7 +106,7 @@ impl<'a> RunContext<'a> {
             plan: self.plan,
             stages,
             improvers: &[],
-            flip_test: FlipTest::new(self.quality_field.reference()),
+            flip_test: self.flip_test.clone(),
             ref_normals: self.ref_normals.clone(),
             input_pairs: self.input_pairs,
             embedded_input: self.embedded_input,
