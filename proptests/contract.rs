@@ -100,6 +100,7 @@ proptest! {
             processed: &processed,
             feature_edges: None,
             corners: None,
+            blocked: None,
         };
         let all: Vec<FaceId> = mesh.faces().collect();
         let faces = conemesh::patches::shrink_breadth_first(&ctx, &all, start, target);

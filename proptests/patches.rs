@@ -42,7 +42,7 @@ proptest! {
         let m = surface(kind, seed);
         let topo = Topology::build(&m);
         let processed = vec![false; m.n_faces()];
-        let ctx = PatchContext { mesh: &m, topology: &topo, processed: &processed, feature_edges: None, corners: None };
+        let ctx = PatchContext { mesh: &m, topology: &topo, processed: &processed, feature_edges: None, corners: None, blocked: None };
         let mut rng = conemesh::Rng::seed_from_u64(seed);
         let start = FaceId::new(rng.random_range(0..m.n_faces()));
         let mut disk = DiskPatch::new(&ctx, start);
@@ -60,6 +60,38 @@ proptest! {
             if rule.is_ok() {
                 disk.try_add(t).expect("checked");
             }
+        }
+    }
+
+    /// A batch's later patches: with the faces around an earlier patch blocked, both built-in
+    /// strategies return a certified disk with no blocked face (so a vertex apart from the
+    /// earlier patch), or nothing.
+    #[test]
+    fn strategies_keep_off_blocked_faces(kind in 0u8..5, seed in 0u64..1000, kring in any::<bool>()) {
+        let m = surface(kind, seed);
+        let topo = Topology::build(&m);
+        let cone = ConePatches::default();
+        let kr = KRingDisks::default();
+        let s: &dyn PatchStrategy = if kring { &kr } else { &cone };
+        let mut rng = conemesh::Rng::seed_from_u64(seed);
+        // Some faces processed, as in the middle of a run.
+        let processed: Vec<bool> = (0..m.n_faces()).map(|_| rng.random_bool(0.3)).collect();
+        let free = PatchContext { mesh: &m, topology: &topo, processed: &processed, feature_edges: None, corners: None, blocked: None };
+        let Some(first) = s.next_patch(&free, &mut rng).expect("a patch") else { return Ok(()) };
+        let mut blocked = vec![false; m.n_faces()];
+        for f in &first.faces {
+            for v in m.face(*f) {
+                for g in topo.vertex_faces(v) {
+                    blocked[g.idx()] = true;
+                }
+            }
+        }
+        let ctx = PatchContext { blocked: Some(&blocked), ..free };
+        if let Some(second) = s.next_patch(&ctx, &mut rng).expect("a patch or none") {
+            prop_assert!(certify_disk(&m, &second.faces).is_ok());
+            prop_assert!(second.faces.iter().all(|f| !blocked[f.idx()]), "a blocked face in the second patch");
+            let first_vertices: std::collections::HashSet<_> = first.faces.iter().flat_map(|f| m.face(*f)).collect();
+            prop_assert!(second.faces.iter().flat_map(|f| m.face(*f)).all(|v| !first_vertices.contains(&v)), "a shared vertex");
         }
     }
 

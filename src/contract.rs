@@ -89,6 +89,7 @@ pub fn patch_strategy(
             processed: &processed,
             feature_edges: case.feature_edges,
             corners: case.corners,
+            blocked: None,
         };
         let unprocessed = processed.iter().filter(|p| !**p).count();
         let failed = |e: crate::patches::PatchError| ContractViolation::Failed {

@@ -134,34 +134,56 @@ pub fn stitch(
     patch_faces: &[FaceId],
     replacement: &Replacement,
 ) -> Result<Vec<FaceId>, StitchError> {
+    let mut new = stitch_all(work, &[(patch_faces, replacement)])?;
+    Ok(new.pop().unwrap_or_default())
+}
+
+/// [`stitch`] for several patches with disjoint face sets at once (a batch of Algorithm 1,
+/// ids of the same working mesh): the faces of all patches are dropped, the replacements
+/// appended in order, their new vertices numbered in order. The arrays come out exactly as
+/// from stitching the patches one after another (with their face ids followed), in one pass
+/// over the faces instead of one per patch. Returns each patch's new faces. On an error the
+/// working mesh is untouched.
+pub fn stitch_all(
+    work: &mut WorkingMesh,
+    patches: &[(&[FaceId], &Replacement)],
+) -> Result<Vec<Vec<FaceId>>, StitchError> {
     let nf = work.mesh.n_faces();
     let mut remove = vec![false; nf];
-    for &f in patch_faces {
-        if f.idx() >= nf || remove[f.idx()] {
-            return Err(StitchError::BadFace(f));
+    let mut base = work.mesh.n_vertices() as u32;
+    let mut new_tris = Vec::with_capacity(patches.len());
+    for (patch_faces, replacement) in patches {
+        for &f in *patch_faces {
+            if f.idx() >= nf || remove[f.idx()] {
+                return Err(StitchError::BadFace(f));
+            }
+            remove[f.idx()] = true;
         }
-        remove[f.idx()] = true;
-    }
-    let base = work.mesh.n_vertices() as u32;
-    let nv_new = replacement.new_positions.len() as u32;
-    let mut tris = Vec::with_capacity(replacement.triangles.len());
-    for (i, t) in replacement.triangles.iter().enumerate() {
-        let mut out = [VertexId(0); 3];
-        for (k, pv) in t.iter().enumerate() {
-            out[k] = match *pv {
-                PatchVertex::Existing(v) if v.idx() < work.mesh.n_vertices() => v,
-                PatchVertex::New(j) if j < nv_new => VertexId(base + j),
-                other => {
-                    return Err(StitchError::BadVertex {
-                        triangle: i,
-                        vertex: format!("{other:?}"),
-                    })
-                }
-            };
+        let n_old = work.mesh.n_vertices();
+        let nv_new = replacement.new_positions.len() as u32;
+        let mut tris = Vec::with_capacity(replacement.triangles.len());
+        for (i, t) in replacement.triangles.iter().enumerate() {
+            let mut out = [VertexId(0); 3];
+            for (k, pv) in t.iter().enumerate() {
+                out[k] = match *pv {
+                    PatchVertex::Existing(v) if v.idx() < n_old => v,
+                    PatchVertex::New(j) if j < nv_new => VertexId(base + j),
+                    other => {
+                        return Err(StitchError::BadVertex {
+                            triangle: i,
+                            vertex: format!("{other:?}"),
+                        })
+                    }
+                };
+            }
+            tris.push(out);
         }
-        tris.push(out);
+        base += nv_new;
+        new_tris.push(tris);
     }
-    let mut triangles = Vec::with_capacity(nf - patch_faces.len() + tris.len());
+    let removed = remove.iter().filter(|r| **r).count();
+    let added: usize = new_tris.iter().map(Vec::len).sum();
+    let mut triangles = Vec::with_capacity(nf - removed + added);
     let mut processed = Vec::with_capacity(triangles.capacity());
     for (f, gone) in remove.iter().enumerate() {
         if !gone {
@@ -169,22 +191,28 @@ pub fn stitch(
             processed.push(work.processed[f]);
         }
     }
-    let first_new = triangles.len();
-    triangles.extend_from_slice(&tris);
+    let mut new_faces = Vec::with_capacity(patches.len());
+    for tris in &new_tris {
+        let first = triangles.len();
+        triangles.extend_from_slice(tris);
+        new_faces.push((first..triangles.len()).map(FaceId::new).collect());
+    }
     processed.resize(triangles.len(), true);
     work.mesh.triangles = triangles;
-    work.mesh
-        .positions
-        .extend_from_slice(&replacement.new_positions);
-    work.locations.extend_from_slice(&replacement.new_locations);
-    let n = work.mesh.n_vertices();
-    work.curve.resize(n - replacement.new_positions.len(), None);
-    for i in 0..replacement.new_positions.len() {
-        work.curve
-            .push(replacement.new_curve.get(i).copied().flatten());
-    }
     work.processed = processed;
-    Ok((first_new..work.mesh.n_faces()).map(FaceId::new).collect())
+    for (_, replacement) in patches {
+        work.mesh
+            .positions
+            .extend_from_slice(&replacement.new_positions);
+        work.locations.extend_from_slice(&replacement.new_locations);
+        let n = work.mesh.n_vertices();
+        work.curve.resize(n - replacement.new_positions.len(), None);
+        for i in 0..replacement.new_positions.len() {
+            work.curve
+                .push(replacement.new_curve.get(i).copied().flatten());
+        }
+    }
+    Ok(new_faces)
 }
 
 #[cfg(test)]

@@ -154,6 +154,7 @@ fn growth_respects_c_max_and_costs_are_recorded() {
         processed: &processed,
         feature_edges: None,
         corners: None,
+        blocked: None,
     };
     let cone = conemesh::patches::fit_cone(&m, &[FaceId(0), FaceId(1)]);
     for c_max in [0.01, 0.1, 1.0] {

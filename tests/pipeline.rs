@@ -30,8 +30,13 @@ fn run(mesh: &TriMesh, seed: u64) -> (MetricField, RemeshResult) {
         calls += 1;
     })
     .expect("remesh succeeds with all certificates");
-    // Progress is reported for the patches of Algorithm 1's loop (the improvers' come after).
-    assert_eq!(calls, result.report.loop_patches);
+    // Progress is reported once per batch of Algorithm 1's loop (the improvers' patches come
+    // after): at least one patch, at most `batch` patches each.
+    let patches = result.report.loop_patches;
+    assert!(
+        calls <= patches && calls * options.batch >= patches,
+        "{calls} reports for {patches} patches"
+    );
     assert!(result.report.loop_patches <= mesh.n_faces());
     (field, result)
 }
@@ -145,10 +150,12 @@ fn assert_certified(input: &TriMesh, field: &MetricField, r: &RemeshResult) {
 }
 
 /// A strategy that delegates to the paper's [`ConePatches`] and records, before every
-/// patch, how many faces of the working mesh are still unprocessed.
+/// batch (the first request of a batch sees no blocked faces), how many faces of the working
+/// mesh are still unprocessed, and counts all requests.
 struct Recording {
     inner: ConePatches,
     unprocessed: Arc<Mutex<Vec<usize>>>,
+    requests: Arc<Mutex<usize>>,
 }
 
 impl PatchStrategy for Recording {
@@ -160,8 +167,11 @@ impl PatchStrategy for Recording {
         ctx: &PatchContext<'_>,
         rng: &mut ChaCha8Rng,
     ) -> Result<Option<Patch>, PatchError> {
-        let left = ctx.processed.iter().filter(|p| !**p).count();
-        self.unprocessed.lock().expect("not poisoned").push(left);
+        if ctx.blocked.is_none() {
+            let left = ctx.processed.iter().filter(|p| !**p).count();
+            self.unprocessed.lock().expect("not poisoned").push(left);
+        }
+        *self.requests.lock().expect("not poisoned") += 1;
         self.inner.next_patch(ctx, rng)
     }
 }
@@ -171,10 +181,12 @@ fn assert_terminates(mesh: &TriMesh, seed: u64) {
     let field =
         MetricField::from_curvature(norm.apply(mesh), &MetricOptions::default()).expect("metric");
     let unprocessed = Arc::new(Mutex::new(Vec::new()));
+    let requests = Arc::new(Mutex::new(0usize));
     let stages = Stages {
         patches: Box::new(Recording {
             inner: ConePatches::default(),
             unprocessed: unprocessed.clone(),
+            requests: requests.clone(),
         }),
         ..Stages::default()
     };
@@ -184,8 +196,12 @@ fn assert_terminates(mesh: &TriMesh, seed: u64) {
     };
     let r = remesh(&field, &stages, &options, |_| {}).expect("remesh succeeds");
     let seen = unprocessed.lock().expect("not poisoned").clone();
-    // The strategy is asked once per patch (never again once nothing is left).
-    assert_eq!(seen.len(), r.report.loop_patches, "one request per patch");
+    // The strategy is asked at least once per patch and opens each batch (never again once
+    // nothing is left); each batch takes between 1 and `batch` patches.
+    let asked = *requests.lock().expect("not poisoned");
+    let patches = r.report.loop_patches;
+    assert!(asked >= patches, "{asked} requests for {patches} patches");
+    assert!(seen.len() <= patches && seen.len() * options.batch >= patches);
     assert_eq!(
         seen[0],
         mesh.n_faces(),
@@ -194,7 +210,7 @@ fn assert_terminates(mesh: &TriMesh, seed: u64) {
     for (i, w) in seen.windows(2).enumerate() {
         assert!(
             w[1] < w[0],
-            "patch {} did not reduce the unprocessed count ({} -> {})",
+            "batch {} did not reduce the unprocessed count ({} -> {})",
             i,
             w[0],
             w[1]

@@ -1,11 +1,14 @@
-//! `conemesh remesh` is reproducible (issue 9): the same seed gives byte-identical output
-//! files whatever the number of rayon threads, and a different seed gives a different mesh.
+//! `conemesh remesh` is reproducible (issues 9 and 19): the same seed gives byte-identical
+//! output files whatever the number of threads, and a different seed gives a different mesh.
 //!
-//! The pipeline draws randomness from one ChaCha8 stream in patch order; parallel code
-//! (distance queries, metric evaluation) must not change any result. Running the binary
-//! with `RAYON_NUM_THREADS=1` and `=2` checks exactly that, on the written bytes.
+//! The patch strategy draws from the seed's stream 0 and every patch from its own stream
+//! (its slot in the loop); the patches of a batch run at the same time and are stitched in
+//! batch order, and the other parallel code (distance queries, metric evaluation) must not
+//! change any result. Running the binary with `RAYON_NUM_THREADS=1` and `=2`, and the library
+//! in rayon pools of 1, 2 and 4 threads, checks exactly that, on the written bytes.
 
-use conemesh::mesh::generators;
+use conemesh::mesh::{generators, TriMesh};
+use conemesh::pipeline::{RemeshOptions, Remesher};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -66,4 +69,98 @@ fn same_seed_same_bytes_on_3holes() {
         "/../shared/meshes/3holes.off"
     ));
     assert_reproducible(input, dir.path());
+}
+
+/// The library's output in a rayon pool of `threads` threads, as the bit patterns of its
+/// coordinates and its triangles, with the run's loop patch and batch counts.
+fn remesh_in_pool(
+    mesh: &TriMesh,
+    threads: usize,
+    batch: usize,
+) -> (Vec<u64>, Vec<[u32; 3]>, usize, usize) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool");
+    let options = RemeshOptions {
+        seed: 3,
+        batch,
+        ..RemeshOptions::default()
+    };
+    let r = pool
+        .install(|| Remesher::new(options).run(mesh))
+        .expect("remesh succeeds");
+    let bits = r
+        .mesh
+        .positions
+        .iter()
+        .flat_map(|p| p.iter().map(|x| x.to_bits()))
+        .collect();
+    let tris = r.mesh.triangles.iter().map(|t| t.map(|v| v.0)).collect();
+    (
+        bits,
+        tris,
+        r.unit.report.loop_patches,
+        r.unit.report.loop_batches,
+    )
+}
+
+/// Parallel patches (issue 19): batches of several patches really ran (fewer batches than
+/// patches), and 1, 2 and 4 threads give the same bits, on a closed surface and one with
+/// boundary and genus.
+#[test]
+fn parallel_batches_give_the_same_bits_for_every_thread_count() {
+    let meshes = [
+        generators::torus(1.0, 0.35, 40, 16),
+        generators::genus_plate(2, 1),
+    ];
+    for (k, mesh) in meshes.iter().enumerate() {
+        let one = remesh_in_pool(mesh, 1, 8);
+        let (patches, batches) = (one.2, one.3);
+        assert!(
+            batches < patches,
+            "mesh {k}: {patches} patches in {batches} batches"
+        );
+        for threads in [2, 4] {
+            let other = remesh_in_pool(mesh, threads, 8);
+            assert!(one == other, "mesh {k}: 1 and {threads} threads differ");
+        }
+        // The batch size is part of the algorithm: one patch at a time is another run.
+        let serial = remesh_in_pool(mesh, 2, 1);
+        assert_eq!(serial.2, serial.3, "mesh {k}: batches of one patch");
+        assert!(
+            serial.0 != one.0,
+            "mesh {k}: batch 1 and batch 8 gave the same mesh"
+        );
+    }
+}
+
+/// `--threads N` sets the pool like `RAYON_NUM_THREADS`, and 0 is refused by name.
+#[test]
+fn threads_option_gives_the_same_bytes_and_refuses_zero() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let input = dir.path().join("torus.off");
+    conemesh::io::write_mesh(&input, &generators::torus(1.0, 0.35, 40, 16)).expect("write");
+    let env_one = remesh(&input, &dir.path().join("env1.obj"), 5, 1);
+    let run = |args: &[&str], out: &str| {
+        Command::new(env!("CARGO_BIN_EXE_conemesh"))
+            .arg("remesh")
+            .arg(&input)
+            .arg("-o")
+            .arg(dir.path().join(out))
+            .args(["--seed", "5", "--quiet"])
+            .args(args)
+            .output()
+            .expect("run conemesh")
+    };
+    let o = run(&["--threads", "2"], "t2.obj");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read(dir.path().join("t2.obj")).expect("output") == env_one);
+    let zero = run(&["--threads", "0"], "t0.obj");
+    assert!(!zero.status.success());
+    assert!(String::from_utf8_lossy(&zero.stderr).contains("--threads must be at least 1"));
+    assert!(
+        !dir.path().join("t0.obj").exists(),
+        "no output after a refused option"
+    );
 }

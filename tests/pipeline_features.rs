@@ -196,6 +196,7 @@ impl PatchStrategy for IgnoresFeatures {
             processed: ctx.processed,
             feature_edges: None,
             corners: ctx.corners,
+            blocked: ctx.blocked,
         };
         self.0.next_patch(&blind, rng)
     }

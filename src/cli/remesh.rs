@@ -104,6 +104,16 @@ pub struct RemeshArgs {
     /// sweep's output with new patches, so the old patch seams get remeshed too.
     #[arg(long, default_value_t = RemeshOptions::default().sweeps)]
     pub sweeps: usize,
+    /// Patches remeshed at the same time: Algorithm 1 takes up to this many patches, a vertex
+    /// apart, on the same working mesh, remeshes them in parallel and stitches them in order.
+    /// The output depends on this number and the seed, not on the thread count; 1 = one patch
+    /// at a time.
+    #[arg(long, default_value_t = RemeshOptions::default().batch)]
+    pub batch: usize,
+    /// Worker threads (default: RAYON_NUM_THREADS when set, else one per core). The output is
+    /// the same for every thread count.
+    #[arg(long)]
+    pub threads: Option<usize>,
     /// Keep input vertices whose angle defect |2π − angle sum| is at least this many radians
     /// (tips, cone points, corners) as output vertices. 0 keeps none (the paper).
     #[arg(long, default_value_t = 1.0)]
@@ -179,6 +189,9 @@ pub struct RemeshArgs {
 pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     let t_start = Instant::now();
     check_output_paths(&args)?;
+    if let Some(n) = args.threads {
+        super::set_threads(n)?;
+    }
     let (name, mesh) = match &args.mesh {
         Some(p) => {
             let loaded =
@@ -397,6 +410,7 @@ fn options(args: &RemeshArgs) -> RemeshOptions {
         })),
         max_patches: args.max_patches,
         sweeps: args.sweeps,
+        batch: args.batch,
         corner_defect: (args.corner_defect != 0.0).then_some(args.corner_defect),
         feature_angle: (args.feature_angle != 0.0).then_some(args.feature_angle),
         sizes: conemesh::metric::SizeOptions {

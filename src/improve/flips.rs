@@ -6,7 +6,7 @@ use super::SurfaceContext;
 use crate::ids::{EdgeKey, FaceId, VertexId};
 use crate::invariants::{candidate_embedded_local, is_degenerate_triangle, FaceGrid};
 use crate::mesh::{bbox_of, TriMesh};
-use crate::quality::{face_metric, triangle_quality};
+use crate::quality::{face_metric, triangle_q};
 use crate::stitch::WorkingMesh;
 use nalgebra::Matrix3;
 use std::collections::{HashMap, HashSet};
@@ -41,7 +41,7 @@ pub fn connectivity_update(ctx: &SurfaceContext<'_>, work: &mut WorkingMesh) -> 
 
 /// The metric quality of triangle `t` of `mesh` (the metric of its vertices' tensors).
 fn quality(mesh: &TriMesh, metrics: &[Matrix3<f64>], t: [VertexId; 3]) -> f64 {
-    triangle_quality(t.map(|v| mesh.positions[v.idx()]), &face_metric(metrics, t)).q
+    triangle_q(t.map(|v| mesh.positions[v.idx()]), &face_metric(metrics, t))
 }
 
 /// Two faces `f1 = (a, b, c)` and `f2 = (b, a, d)` across the edge `ab`.

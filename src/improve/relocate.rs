@@ -8,7 +8,7 @@ use crate::boundary::CurvePoint;
 use crate::ids::{FaceId, VertexId};
 use crate::invariants::{candidate_embedded_local, is_degenerate_triangle, FaceGrid};
 use crate::mesh::{bbox_of, SurfaceLocation, Topology, TriMesh};
-use crate::quality::{face_metric, triangle_quality};
+use crate::quality::{face_metric, triangle_q};
 use crate::stitch::WorkingMesh;
 use nalgebra::{Matrix3, Point3, Vector3};
 
@@ -87,7 +87,7 @@ fn fan_quality(mesh: &TriMesh, metrics: &[Matrix3<f64>], fan: &[FaceId]) -> f64 
     fan.iter()
         .map(|f| {
             let t = mesh.triangles[f.idx()];
-            triangle_quality(t.map(|u| mesh.positions[u.idx()]), &face_metric(metrics, t)).q
+            triangle_q(t.map(|u| mesh.positions[u.idx()]), &face_metric(metrics, t))
         })
         .fold(f64::INFINITY, f64::min)
 }

@@ -259,6 +259,50 @@ pub fn candidate_arrays(
     (positions, triangles)
 }
 
+/// Pairs `(j, k)`, `j < k`, of candidates (replacements of vertex-disjoint patches of the same
+/// working mesh, in batch order) whose new faces intersect (exact). Each candidate was certified
+/// against the working mesh it was made on ([`certify_candidate_embedded`]); what that could
+/// not see is another candidate of the same batch. The patches share no vertex, so any contact
+/// between their new faces is an intersection.
+pub fn crossing_candidates(work: &WorkingMesh, candidates: &[&Replacement]) -> Vec<(usize, usize)> {
+    if candidates.len() < 2 {
+        return Vec::new();
+    }
+    // A small mesh of the candidates' new faces only, with its own vertex numbering.
+    let mut local: HashMap<VertexId, VertexId> = HashMap::new();
+    let mut positions: Vec<Point3<f64>> = Vec::new();
+    let mut triangles = Vec::new();
+    let mut owner = Vec::new();
+    for (k, r) in candidates.iter().enumerate() {
+        let base = positions.len() as u32;
+        positions.extend_from_slice(&r.new_positions);
+        for t in &r.triangles {
+            let tri = t.map(|v| match v {
+                PatchVertex::New(i) => VertexId(base + i),
+                PatchVertex::Existing(g) => *local.entry(g).or_insert_with(|| {
+                    positions.push(work.mesh.positions[g.idx()]);
+                    VertexId::new(positions.len() - 1)
+                }),
+            });
+            triangles.push(tri);
+            owner.push(k);
+        }
+    }
+    let mesh = TriMesh {
+        positions,
+        triangles,
+    };
+    let mut pairs: Vec<(usize, usize)> = super::self_intersections(&mesh)
+        .into_iter()
+        .map(|(a, b)| (owner[a.idx()], owner[b.idx()]))
+        .filter(|(j, k)| j != k)
+        .map(|(j, k)| (j.min(k), j.max(k)))
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -36,9 +36,19 @@ fn polygon_area2(pts: &[Point2<f64>]) -> f64 {
 /// taken by [`orient2d`] and half-open edges (an edge counts when exactly one endpoint is
 /// strictly above `p`).
 pub fn point_in_polygon(poly: &[Point2<f64>], p: &Point2<f64>) -> Option<bool> {
+    crossing_test(poly, 0..poly.len(), p)
+}
+
+/// [`point_in_polygon`] over the edges `edges` (edge `i` runs from `poly[i]` to the next
+/// corner): the same verdict whenever `edges` holds every edge whose y-range contains `p.y`.
+fn crossing_test(
+    poly: &[Point2<f64>],
+    edges: impl IntoIterator<Item = usize>,
+    p: &Point2<f64>,
+) -> Option<bool> {
     let n = poly.len();
     let mut inside = false;
-    for i in 0..n {
+    for i in edges {
         let (a, b) = (&poly[i], &poly[(i + 1) % n]);
         let o = orient2d(a, b, p);
         if o == Sign::Zero
@@ -63,6 +73,67 @@ pub fn point_in_polygon(poly: &[Point2<f64>], p: &Point2<f64>) -> Option<bool> {
         }
     }
     Some(inside)
+}
+
+/// [`point_in_polygon`] for many points: the polygon's edges bucketed by horizontal slabs of
+/// their y-range, so a point meets only the edges of its slab (the only ones the crossing test
+/// counts, or that can hold the point) instead of all of them. Same verdicts, exact.
+pub struct PolygonSlabs<'a> {
+    poly: &'a [Point2<f64>],
+    y0: f64,
+    height: f64,
+    slabs: Vec<Vec<usize>>,
+}
+
+impl<'a> PolygonSlabs<'a> {
+    /// Index `poly` (finite corners).
+    pub fn new(poly: &'a [Point2<f64>]) -> PolygonSlabs<'a> {
+        let n = poly.len();
+        let (lo, hi) = poly
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+                (l.min(q.y), h.max(q.y))
+            });
+        let k = n.max(1);
+        let height = if hi > lo { (hi - lo) / k as f64 } else { 1.0 };
+        let mut index = PolygonSlabs {
+            poly,
+            y0: lo,
+            height,
+            slabs: vec![Vec::new(); k],
+        };
+        for i in 0..n {
+            let (a, b) = (poly[i].y, poly[(i + 1) % n].y);
+            let (from, to) = (index.slab(a.min(b)), index.slab(a.max(b)));
+            for slab in &mut index.slabs[from..=to] {
+                slab.push(i);
+            }
+        }
+        index
+    }
+
+    /// The slab holding height `y`, clamped to the polygon's range (a rounding of the slab
+    /// arithmetic at most moves a boundary value to a neighbouring slab, so the edges are
+    /// registered one slab wider on each side).
+    fn slab(&self, y: f64) -> usize {
+        let k = ((y - self.y0) / self.height).floor();
+        (k.max(0.0) as usize).min(self.slabs.len().max(1) - 1)
+    }
+
+    /// [`point_in_polygon`] of `p`.
+    pub fn contains(&self, p: &Point2<f64>) -> Option<bool> {
+        if self.slabs.is_empty() {
+            return point_in_polygon(self.poly, p);
+        }
+        let k = self.slab(p.y);
+        // The neighbours too: an edge ending exactly on a slab boundary.
+        let lo = k.saturating_sub(1);
+        let hi = (k + 1).min(self.slabs.len() - 1);
+        let mut edges: Vec<usize> = self.slabs[lo..=hi].iter().flatten().copied().collect();
+        edges.sort_unstable();
+        edges.dedup();
+        crossing_test(self.poly, edges, p)
+    }
 }
 
 /// Certify a planar remesh `out` of `domain` (Sec. 3.3, invariants of the LCT remesher):
@@ -249,9 +320,10 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
     }
     // (8) interior vertices strictly inside.
     let on_loop: std::collections::HashSet<u32> = expected.iter().map(|e| e.0).collect();
+    let slabs = PolygonSlabs::new(&poly);
     let outside: Vec<String> = (0..np as u32)
         .filter(|i| !on_loop.contains(i))
-        .filter(|&i| point_in_polygon(&poly, &out.points[i as usize]) != Some(true))
+        .filter(|&i| slabs.contains(&out.points[i as usize]) != Some(true))
         .map(|i| format!("v{i}"))
         .collect();
     if !outside.is_empty() {
@@ -329,6 +401,51 @@ mod tests {
         assert!(
             matches!(e, Err(InvariantError::PlanarInvalid { reason }) if reason.contains("(v3, v0)"))
         );
+    }
+
+    #[test]
+    fn slabs_agree_with_the_plain_crossing_test() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = crate::Rng::seed_from_u64(3);
+        for case in 0..200 {
+            // A star-shaped polygon, some corners on a coarse grid so that points hit corners,
+            // edges and slab boundaries exactly.
+            let n = rng.random_range(3..40);
+            let poly: Vec<Point2<f64>> = (0..n)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * i as f64 / n as f64;
+                    let r = rng.random_range(0.3..1.0);
+                    let (x, y) = (r * t.cos(), r * t.sin());
+                    match case % 2 {
+                        0 => {
+                            Point2::new((x * 4.0).round() / 4.0 + t * 1e-3, (y * 4.0).round() / 4.0)
+                        }
+                        _ => Point2::new(x, y),
+                    }
+                })
+                .collect();
+            let slabs = PolygonSlabs::new(&poly);
+            let mut probes: Vec<Point2<f64>> = poly.clone();
+            for i in 0..n {
+                let (a, b) = (poly[i], poly[(i + 1) % n]);
+                probes.push(Point2::from((a.coords + b.coords) * 0.5));
+            }
+            for _ in 0..200 {
+                let (x, y) = (rng.random_range(-1.2..1.2), rng.random_range(-1.2..1.2));
+                probes.push(Point2::new(x, y));
+                probes.push(Point2::new(
+                    (x * 4.0).round() / 4.0,
+                    (y * 4.0).round() / 4.0,
+                ));
+            }
+            for p in &probes {
+                assert_eq!(
+                    slabs.contains(p),
+                    point_in_polygon(&poly, p),
+                    "case {case}: {p:?}"
+                );
+            }
+        }
     }
 
     #[test]

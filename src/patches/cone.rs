@@ -29,9 +29,18 @@ pub fn pick_seed_vertex(ctx: &PatchContext<'_>, rng: &mut ChaCha8Rng) -> Option<
     for f in mesh.faces() {
         if processed(f) {
             any_processed = true;
-        } else {
+        } else if !ctx.is_blocked(f) {
             free.extend(mesh.face(f));
         }
+    }
+    // A seed next to another patch of the batch could only start a patch inside its margin.
+    if ctx.blocked.is_some() {
+        free.retain(|&v| {
+            !ctx.topology
+                .vertex_faces(v)
+                .iter()
+                .any(|&f| ctx.is_blocked(f))
+        });
     }
     if free.is_empty() {
         return None;
@@ -60,7 +69,7 @@ pub fn unprocessed_ring(ctx: &PatchContext<'_>, v: VertexId) -> Vec<FaceId> {
         .vertex_faces(v)
         .iter()
         .copied()
-        .filter(|f| !ctx.processed.get(f.idx()).copied().unwrap_or(true))
+        .filter(|f| !ctx.processed.get(f.idx()).copied().unwrap_or(true) && !ctx.is_blocked(*f))
         .collect();
     ring.sort_unstable();
     ring

@@ -88,6 +88,7 @@ pub fn cover(
             processed: &processed,
             feature_edges: opts.feature_edges.as_ref(),
             corners: opts.corners.as_deref(),
+            blocked: None,
         };
         let patch = match strategy.next_patch(&ctx, rng) {
             Ok(Some(p)) => p,

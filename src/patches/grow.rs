@@ -48,6 +48,8 @@ pub enum Refusal {
     /// It would close the fan of a corner vertex ([`PatchContext::corners`]), making it an
     /// interior vertex of the patch.
     Corner(VertexId),
+    /// Reserved by another patch of the batch ([`PatchContext::blocked`]).
+    Blocked,
 }
 
 /// A face set that is a topological disk by construction (the exact rule above), with the
@@ -139,6 +141,9 @@ impl<'c, 'a> DiskPatch<'c, 'a> {
     pub fn check_add(&self, t: FaceId) -> Result<(), Refusal> {
         if self.members.contains(&t) {
             return Err(Refusal::InPatch);
+        }
+        if self.ctx.is_blocked(t) {
+            return Err(Refusal::Blocked);
         }
         let tri = self.ctx.mesh.face(t);
         let mut shared = 0;

@@ -119,9 +119,20 @@ pub struct PatchContext<'a> {
     /// `corners[v]`: vertex `v` may not become an interior vertex of a patch (a cone point of
     /// the input, see [`corner_vertices`]); vertices past the end are not corners.
     pub corners: Option<&'a [bool]>,
+    /// `blocked[f]`: face `f` is reserved by another patch of the same batch (it shares a
+    /// vertex with one), so this patch may neither contain it nor grow from it; faces past
+    /// the end are not blocked. The pipeline checks the result: a patch with a blocked face
+    /// ends its batch and waits for the next (see `pipeline` module docs).
+    pub blocked: Option<&'a [bool]>,
 }
 
 impl PatchContext<'_> {
+    /// True when `f` is marked in [`PatchContext::blocked`].
+    pub fn is_blocked(&self, f: FaceId) -> bool {
+        self.blocked
+            .is_some_and(|b| b.get(f.idx()).copied().unwrap_or(false))
+    }
+
     /// True when `v` is marked in [`PatchContext::corners`].
     pub fn is_corner(&self, v: VertexId) -> bool {
         self.corners
@@ -286,6 +297,7 @@ mod tests {
             processed: &processed,
             feature_edges: None,
             corners: Some(&corners),
+            blocked: None,
         };
         // The four faces around vertex 4 in fan order: the last one would close its fan.
         let fan = [FaceId(0), FaceId(1), FaceId(2), FaceId(3)];

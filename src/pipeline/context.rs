@@ -170,6 +170,8 @@ pub struct LoopState {
     pub patches: usize,
     /// Patches of Algorithm 1's loop (set when it ends).
     pub loop_patches: usize,
+    /// Batches of Algorithm 1's loop.
+    pub batches: usize,
     /// The patch budget ran out.
     pub budget_exhausted: bool,
     /// Times and certificate counts.
@@ -180,6 +182,9 @@ pub struct LoopState {
     pub fallbacks: Fallbacks,
     /// What Algorithm 2 did, when it ran.
     pub improvement: Option<super::records::ImprovementReport>,
+    /// `blocked[f]` while a batch is chosen: face `f` shares a vertex with a patch already in
+    /// the batch ([`PatchContext::blocked`]); empty between batches.
+    pub blocked: Vec<bool>,
 }
 
 /// Per-stage times and certificate counts of a run.
@@ -189,6 +194,15 @@ pub struct Counters {
     pub times: StageTimes,
     /// Certificates checked and held.
     pub cert: Certificate,
+}
+
+impl Counters {
+    /// Add another patch's counters (times add up: the stage times of a batch's patches,
+    /// which run at the same time, are summed).
+    pub fn absorb(&mut self, other: Counters) {
+        self.times.add(&other.times);
+        self.cert.add(&other.cert);
+    }
 }
 
 impl LoopState {
@@ -231,11 +245,13 @@ impl LoopState {
             sweep: 1,
             patches: 0,
             loop_patches: 0,
+            batches: 0,
             budget_exhausted: false,
             counters: Counters::default(),
             records: Vec::new(),
             fallbacks: Fallbacks::default(),
             improvement: None,
+            blocked: Vec::new(),
             work,
             topo,
             features,
@@ -283,6 +299,20 @@ impl LoopState {
             processed: &self.work.processed,
             feature_edges: self.feature_edges(),
             corners: Some(&ctx.corners),
+            blocked: (!self.blocked.is_empty()).then_some(&self.blocked[..]),
+        }
+    }
+
+    /// Reserve `faces` (a patch taken into the batch): every face sharing a vertex with them
+    /// is blocked for the batch's later patches.
+    pub fn block_around(&mut self, faces: &[crate::ids::FaceId]) {
+        self.blocked.resize(self.work.mesh.n_faces(), false);
+        for f in faces {
+            for v in self.work.mesh.triangles[f.idx()] {
+                for g in self.topo.vertex_faces(v) {
+                    self.blocked[g.idx()] = true;
+                }
+            }
         }
     }
 

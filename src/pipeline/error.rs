@@ -74,6 +74,13 @@ pub enum StageError {
     /// A certificate of the stage's output failed.
     #[error(transparent)]
     Certificate(#[from] InvariantError),
+    /// The patch's new faces cross those of an earlier patch of the same batch (exact): it
+    /// waits for a later batch.
+    #[error("its new faces cross those of patch {earlier} of the same batch (deferred to a later batch)")]
+    Deferred {
+        /// the earlier patch's place in the batch
+        earlier: usize,
+    },
     /// The fidelity control kept a factor count that does not match the working mesh.
     #[error("{factors} fidelity factors for {vertices} vertices after stitching")]
     FactorCount {

@@ -234,6 +234,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
         l_tar: plan.l_tar,
         patches: state.patches,
         loop_patches: state.loop_patches,
+        loop_batches: state.batches,
         budget_exhausted: state.budget_exhausted,
         times: state.counters.times,
         certificate: state.counters.cert,

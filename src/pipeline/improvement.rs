@@ -99,6 +99,9 @@ fn patch_pass(
         (a, b) => a.or(b),
     };
     let ictx = ctx.for_improvement(stages);
+    // The surface passes before this one flip edges without keeping the loop's topology in
+    // step: the strategy must not grow patches on a stale one.
+    state.topo = crate::mesh::Topology::build(&state.work.mesh);
     state.work.processed = targets.iter().map(|t| !t).collect();
     while state.work.unprocessed() > 0 {
         if budget.is_some_and(|b| pass.patches >= b) {
@@ -106,7 +109,9 @@ fn patch_pass(
             break;
         }
         let patch = super::next_patch(&ictx, state, rng)?;
-        let outcome = match step::patch_step(&ictx, state, &patch, rng)? {
+        let pid = crate::ids::PatchId::new(state.patches);
+        let (outcome, log) = step::patch_step(&ictx, state, pid, &patch, rng)?;
+        let outcome = match outcome {
             PatchOutcome::Remeshed {
                 faces,
                 refined,
@@ -121,7 +126,7 @@ fn patch_pass(
             }
             outcome => outcome,
         };
-        replace::replace_patch(&ictx, state, outcome)?;
+        replace::replace_patch(&ictx, state, outcome, log)?;
         pass.patches += 1;
     }
     state.work.processed.iter_mut().for_each(|p| *p = true);

@@ -81,9 +81,10 @@ pub fn remesh(
     let mut state = LoopState::new(&ctx)?;
     let mut rng = crate::Rng::seed_from_u64(plan.options.seed);
     while state.face_remains(&ctx) {
-        let patch = next_patch(&ctx, &mut state, &mut rng)?; // (a) Sec. 3.2
-        let outcome = step::patch_step(&ctx, &mut state, &patch, &mut rng)?; // (b)-(e)
-        replace::replace_patch(&ctx, &mut state, outcome)?; // replace P, update M
+        let batch = next_batch(&ctx, &mut state, &mut rng)?; // (a) Sec. 3.2, a vertex apart
+        let outcomes = step::batch_steps(&ctx, &state, &batch)?; // (b)-(e), at the same time
+        replace::replace_batch(&ctx, &mut state, outcomes)?; // replace each P, update M
+        state.batches += 1;
         on_progress(state.progress(&ctx));
     }
     state.loop_patches = state.patches;
@@ -103,6 +104,73 @@ fn certified_input_topology(field: &MetricField) -> Result<Topology, PipelineErr
             PipelineError::Input(format!("the input mesh is not an oriented manifold: {e}"))
         })?;
     Ok(topo)
+}
+
+/// Algorithm 1, line 3, for a batch: the strategy's next patches around unprocessed faces, up
+/// to [`RemeshOptions::batch`] (and the patch budget), each sharing no vertex with the earlier
+/// ones (the strategy sees their surroundings as [`crate::patches::PatchContext::blocked`]).
+/// A patch that runs into a blocked face (or next to one: its growth may have been cut short
+/// there) is turned down; the batch closes when the strategy finds no further patch or after
+/// [`MAX_BATCH_MISSES`] such answers. Its RNG draws are the same whatever the thread count.
+fn next_batch(
+    ctx: &RunContext<'_>,
+    state: &mut LoopState,
+    rng: &mut crate::Rng,
+) -> Result<Vec<crate::patches::Patch>, PipelineError> {
+    let o = &ctx.plan.options;
+    let room = o
+        .max_patches
+        .map_or(o.batch, |max| {
+            o.batch.min(max.saturating_sub(state.patches))
+        })
+        .max(1);
+    // The first patch of a sweep sets the processed front alone: the batch's later patches
+    // are seeded on that front, not scattered over an untouched surface.
+    let room = match state.work.processed.iter().any(|p| *p) {
+        true => room,
+        false => 1,
+    };
+    let mut batch = vec![next_patch(ctx, state, rng)?];
+    state.block_around(&batch[0].faces);
+    let mut misses = 0;
+    while batch.len() < room && misses < MAX_BATCH_MISSES {
+        let t0 = Instant::now();
+        let next = ctx
+            .stages
+            .patches
+            .next_patch(&state.patch_context(ctx), rng);
+        state.counters.times.patches += t0.elapsed().as_secs_f64();
+        match next {
+            Ok(Some(p)) if clear_of_blocked(state, &p.faces) => {
+                state.block_around(&p.faces);
+                batch.push(p);
+            }
+            Ok(Some(_)) => misses += 1,
+            // No further patch, or an error the next batch's first patch meets unblocked.
+            _ => break,
+        }
+    }
+    state.blocked.clear();
+    Ok(batch)
+}
+
+/// Strategy answers a batch may turn down (patches that touched the blocked faces) before it
+/// closes.
+const MAX_BATCH_MISSES: usize = 3;
+
+/// No face of `faces` is blocked or shares an edge with a blocked face: the strategy never had
+/// a blocked face to refuse, so the patch is the one it would have made without the mark (not
+/// cut short where the batch's earlier patches lie).
+fn clear_of_blocked(state: &LoopState, faces: &[crate::ids::FaceId]) -> bool {
+    faces.iter().all(|&f| {
+        !state.blocked[f.idx()]
+            && (0..3).all(|i| {
+                state
+                    .topo
+                    .neighbor(f, i)
+                    .is_none_or(|g| !state.blocked[g.idx()])
+            })
+    })
 }
 
 /// Algorithm 1, line 3: the strategy's next patch around an unprocessed face.

@@ -11,7 +11,9 @@ use serde::ser::SerializeStruct;
 use serde::Serialize;
 use std::fmt;
 
-/// Wall time per stage, seconds.
+/// Time per stage, seconds: the patches of a batch run at the same time, and their stage
+/// times are summed, so with several threads the loop's stages add up to more than its wall
+/// time.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct StageTimes {
     /// Patch generation and certify_disk.
@@ -35,6 +37,22 @@ pub struct StageTimes {
     pub improve: f64,
     /// Final self-intersection test.
     pub final_check: f64,
+}
+
+impl StageTimes {
+    /// Add `other`'s times stage by stage.
+    pub fn add(&mut self, other: &StageTimes) {
+        self.patches += other.patches;
+        self.param += other.param;
+        self.transfer += other.transfer;
+        self.remesh2d += other.remesh2d;
+        self.lift += other.lift;
+        self.fidelity += other.fidelity;
+        self.stitch += other.stitch;
+        self.certify += other.certify;
+        self.improve += other.improve;
+        self.final_check += other.final_check;
+    }
 }
 
 /// How many times each certificate was checked and held (a failed check is either an error
@@ -84,6 +102,28 @@ pub struct Certificate {
     pub param_fallbacks: usize,
     /// Free boundary chains resampled on the input's boundary curves.
     pub chains: usize,
+}
+
+impl Certificate {
+    /// Add `other`'s counts (the output's own counts, `input_self_intersecting_pairs`
+    /// included, are `self`'s).
+    pub fn add(&mut self, other: &Certificate) {
+        self.disk += other.disk;
+        self.bijective += other.bijective;
+        self.planar += other.planar;
+        self.planar_refined += other.planar_refined;
+        self.manifold += other.manifold;
+        self.oriented += other.oriented;
+        self.same_topology += other.same_topology;
+        self.boundary_preserved += other.boundary_preserved;
+        self.no_degenerate += other.no_degenerate;
+        self.no_flips += other.no_flips;
+        self.locally_embedded += other.locally_embedded;
+        self.no_self_intersections += other.no_self_intersections;
+        self.self_intersecting_pairs += other.self_intersecting_pairs;
+        self.param_fallbacks += other.param_fallbacks;
+        self.chains += other.chains;
+    }
 }
 
 /// Per-patch record.
@@ -377,6 +417,9 @@ pub struct RemeshReport {
     pub patches: usize,
     /// Those of Algorithm 1's loop.
     pub loop_patches: usize,
+    /// The batches they came in ([`RemeshOptions::batch`]): with several threads, the patches
+    /// of a batch ran at the same time.
+    pub loop_batches: usize,
     /// The patch budget ([`RemeshOptions::max_patches`]) ran out before every face was
     /// processed.
     pub budget_exhausted: bool,

@@ -4,98 +4,189 @@
 use super::context::{a_priori_at, LoopState, RunContext};
 use super::debug::write_debug;
 use super::error::{PipelineError, Stage, StageError};
-use super::step::PatchOutcome;
+use super::records::{FailedAttempt, PatchRecord};
+use super::step::{PatchOutcome, StepLog};
+use crate::fidelity::Refined;
 use crate::ids::{FaceId, PatchId, VertexId};
 use crate::invariants::{self, InvariantError, TopologySignature};
 use crate::mesh::Topology;
-use crate::stitch::stitch;
+use crate::stitch::{stitch_all, Replacement};
 use std::time::Instant;
 
-/// Apply a patch's outcome to the working mesh and certify it: edge- and vertex-manifold
-/// (at the vertices whose fans changed; the input was certified whole before the loop),
-/// consistently oriented, the input's topology and boundary. A violation is a hard error: it
-/// is a bug, not a numerical accident.
+/// Apply one patch's outcome (a batch of one, [`replace_batch`]).
 pub fn replace_patch(
     ctx: &RunContext<'_>,
     state: &mut LoopState,
     outcome: PatchOutcome,
+    log: StepLog,
 ) -> Result<(), PipelineError> {
-    let pid = PatchId::new(state.patches);
-    let (new_faces, record, touched) = match outcome {
-        PatchOutcome::Remeshed {
-            faces,
-            refined,
-            record,
-        } => {
-            let seed = record.seed;
-            let stage_error = |stage, source| PipelineError::Stage {
-                patch: pid,
-                seed: Some(seed),
-                stage,
-                source,
-            };
-            let t0 = Instant::now();
-            // Vertices of the faces the patch removes (its boundary and interior): with the
-            // new faces' vertices, every vertex whose fan changed.
-            let touched: Vec<VertexId> = faces
+    replace_batch(ctx, state, vec![(outcome, log)])
+}
+
+/// Apply the outcomes of a batch's patches (vertex-disjoint, made on the same working mesh, in
+/// batch order) and certify the result: edge- and vertex-manifold (at the vertices whose fans
+/// changed; the input was certified whole before the loop), consistently oriented, the
+/// input's topology and boundary. A violation is a hard error: it is a bug, not a numerical
+/// accident. The patches share no vertex, so no fan is changed by two of them and the
+/// certificate of the stitched batch is the certificate after each of its patches; only their
+/// new faces could meet each other in space (two sheets close together), which is checked
+/// (exact) first: a patch whose new faces cross an earlier one's is deferred (its faces stay
+/// unprocessed, for a later batch) and its failure recorded under the id the next patch takes.
+pub fn replace_batch(
+    ctx: &RunContext<'_>,
+    state: &mut LoopState,
+    outcomes: Vec<(PatchOutcome, StepLog)>,
+) -> Result<(), PipelineError> {
+    let crossing = match ctx.embedded_input {
+        true => {
+            let candidates: Vec<(usize, &Replacement)> = outcomes
                 .iter()
-                .filter(|f| f.idx() < state.work.mesh.n_faces())
-                .flat_map(|f| state.work.mesh.triangles[f.idx()])
+                .enumerate()
+                .filter_map(|(k, (o, _))| match o {
+                    PatchOutcome::Remeshed { refined, .. } => Some((k, &refined.replacement)),
+                    PatchOutcome::Kept { .. } => None,
+                })
                 .collect();
-            let new_faces = stitch(&mut state.work, &faces, &refined.replacement)
-                .map_err(|e| stage_error(Stage::Stitching, e.into()))?;
-            state.counters.times.stitch += t0.elapsed().as_secs_f64();
-            let n = state.work.mesh.n_vertices();
-            let reference = ctx.quality_field.reference();
-            let first_new = n - refined.replacement.new_positions.len();
-            for (k, loc) in refined.replacement.new_locations.iter().enumerate() {
-                let rounds = refined.factors.new.get(k).copied().unwrap_or(1.0);
-                state
-                    .bound
-                    .push(a_priori_at(&ctx.plan.fid_scale, reference, loc) * rounds);
-            }
-            debug_assert_eq!(
-                state.bound.len(),
-                first_new + refined.replacement.new_locations.len()
-            );
-            state
-                .factors
-                .absorb(refined.factors, ctx.plan.options.fidelity.persist, n)
-                .map_err(|(factors, vertices)| {
-                    stage_error(
-                        Stage::FidelityFactors,
-                        StageError::FactorCount { factors, vertices },
-                    )
-                })?;
-            follow_provenance(
-                &mut state.face_patch,
-                &faces,
-                state.work.mesh.n_faces(),
-                pid,
-            );
-            (new_faces, record, touched)
+            let t0 = Instant::now();
+            let only: Vec<&Replacement> = candidates.iter().map(|c| c.1).collect();
+            let pairs = invariants::crossing_candidates(&state.work, &only);
+            state.counters.times.certify += t0.elapsed().as_secs_f64();
+            pairs
+                .into_iter()
+                .map(|(j, k)| (candidates[j].0, candidates[k].0))
+                .collect()
         }
-        PatchOutcome::Kept { faces, record } => {
-            for f in &faces {
-                state.work.processed[f.idx()] = true;
+        false => Vec::new(),
+    };
+    // In order: a patch is deferred when it crosses an accepted earlier one.
+    let mut deferred = vec![false; outcomes.len()];
+    for &(j, k) in &crossing {
+        if !deferred[j] {
+            deferred[k] = true;
+        }
+    }
+    let first_id = state.patches;
+    let mut remeshed: Vec<(PatchId, Vec<FaceId>, Refined, PatchRecord)> = Vec::new();
+    let mut kept_faces: Vec<FaceId> = Vec::new();
+    let mut records = Vec::new();
+    for (k, (outcome, mut log)) in outcomes.into_iter().enumerate() {
+        let pid = PatchId::new(first_id + records.len());
+        for f in &mut log.fallbacks.failures {
+            f.patch = pid;
+        }
+        if deferred[k] {
+            let with = crossing.iter().find(|c| c.1 == k && !deferred[c.0]);
+            log.fallbacks.failures.push(FailedAttempt {
+                patch: pid,
+                faces: match &outcome {
+                    PatchOutcome::Remeshed { faces, .. } | PatchOutcome::Kept { faces, .. } => {
+                        faces.len()
+                    }
+                },
+                stage: Stage::LiftedFaces,
+                error: StageError::Deferred {
+                    earlier: with.map_or(0, |c| c.0),
+                },
+            });
+            log.merge_into(state);
+            continue;
+        }
+        log.merge_into(state);
+        match outcome {
+            PatchOutcome::Remeshed {
+                faces,
+                refined,
+                mut record,
+            } => {
+                record.id = pid;
+                records.push(record.clone());
+                remeshed.push((pid, faces, refined, record));
             }
-            (faces, record, Vec::new())
+            PatchOutcome::Kept { faces, mut record } => {
+                record.id = pid;
+                records.push(record);
+                kept_faces.extend_from_slice(&faces);
+            }
+        }
+    }
+    for f in &kept_faces {
+        state.work.processed[f.idx()] = true;
+    }
+    let t0 = Instant::now();
+    // Vertices of the faces the patches remove (their boundaries and interiors): with the
+    // new faces' vertices, every vertex whose fan changed.
+    let mut touched: Vec<VertexId> = remeshed
+        .iter()
+        .flat_map(|r| &r.1)
+        .filter(|f| f.idx() < state.work.mesh.n_faces())
+        .flat_map(|f| state.work.mesh.triangles[f.idx()])
+        .collect();
+    let batch: Vec<(&[FaceId], &Replacement)> = remeshed
+        .iter()
+        .map(|r| (r.1.as_slice(), &r.2.replacement))
+        .collect();
+    let stitched = stitch_all(&mut state.work, &batch);
+    let new_faces = match stitched {
+        Ok(n) => n,
+        Err(e) => {
+            let r = &remeshed[0];
+            return Err(PipelineError::Stage {
+                patch: r.0,
+                seed: Some(r.3.seed),
+                stage: Stage::Stitching,
+                source: e.into(),
+            });
         }
     };
-    certify_after_patch(ctx, state, pid, record.seed, &new_faces, touched)?;
-    state.records.push(record);
-    state.patches += 1;
+    state.counters.times.stitch += t0.elapsed().as_secs_f64();
+    let reference = ctx.quality_field.reference();
+    let mut n = state.work.mesh.n_vertices()
+        - remeshed
+            .iter()
+            .map(|r| r.2.replacement.new_positions.len())
+            .sum::<usize>();
+    let gone: Vec<FaceId> = remeshed.iter().flat_map(|r| r.1.iter().copied()).collect();
+    drop_provenance(&mut state.face_patch, &gone);
+    for ((pid, _, refined, record), faces) in remeshed.into_iter().zip(&new_faces) {
+        n += refined.replacement.new_positions.len();
+        for (k, loc) in refined.replacement.new_locations.iter().enumerate() {
+            let rounds = refined.factors.new.get(k).copied().unwrap_or(1.0);
+            state
+                .bound
+                .push(a_priori_at(&ctx.plan.fid_scale, reference, loc) * rounds);
+        }
+        state
+            .factors
+            .absorb(refined.factors, ctx.plan.options.fidelity.persist, n)
+            .map_err(|(factors, vertices)| PipelineError::Stage {
+                patch: pid,
+                seed: Some(record.seed),
+                stage: Stage::FidelityFactors,
+                source: StageError::FactorCount { factors, vertices },
+            })?;
+        state.face_patch.extend(faces.iter().map(|_| Some(pid)));
+    }
+    debug_assert_eq!(state.bound.len(), state.work.mesh.n_vertices());
+    debug_assert_eq!(state.face_patch.len(), state.work.mesh.n_faces());
+    let all_new: Vec<FaceId> = new_faces.into_iter().flatten().chain(kept_faces).collect();
+    touched.extend(
+        all_new
+            .iter()
+            .filter(|f| f.idx() < state.work.mesh.n_faces())
+            .flat_map(|f| state.work.mesh.triangles[f.idx()]),
+    );
+    if let Some(first) = records.first() {
+        let (pid, seed) = (first.id, first.seed);
+        certify_after_batch(ctx, state, pid, seed, records.len(), &all_new, touched)?;
+    }
+    state.patches += records.len();
+    state.records.extend(records);
     Ok(())
 }
 
-/// `stitch` drops the patch's faces in order and appends the new ones: the provenance of
-/// every face follows.
-fn follow_provenance(
-    face_patch: &mut Vec<Option<PatchId>>,
-    removed: &[FaceId],
-    n_faces: usize,
-    pid: PatchId,
-) {
+/// `stitch_all` drops the patches' faces in order and appends the new ones: the provenance of
+/// the remaining faces follows (the new faces' is appended by the caller).
+fn drop_provenance(face_patch: &mut Vec<Option<PatchId>>, removed: &[FaceId]) {
     let mut gone = vec![false; face_patch.len()];
     for f in removed {
         gone[f.idx()] = true;
@@ -105,15 +196,16 @@ fn follow_provenance(
         k += 1;
         !gone[k - 1]
     });
-    face_patch.resize(n_faces, Some(pid));
 }
 
-/// The working-mesh certificates after a patch (see [`replace_patch`]).
-fn certify_after_patch(
+/// The working-mesh certificates after a batch of `patches` patches (see [`replace_batch`]);
+/// an error names the batch's first patch.
+fn certify_after_batch(
     ctx: &RunContext<'_>,
     state: &mut LoopState,
     pid: PatchId,
     seed: VertexId,
+    patches: usize,
     new_faces: &[FaceId],
     mut touched: Vec<VertexId>,
 ) -> Result<(), PipelineError> {
@@ -128,12 +220,6 @@ fn certify_after_patch(
     };
     // Local: only the touched vertices' fans changed (`certify_manifold_at`); the whole mesh
     // again after the loop.
-    touched.extend(
-        new_faces
-            .iter()
-            .filter(|f| f.idx() < work.mesh.n_faces())
-            .flat_map(|f| work.mesh.triangles[f.idx()]),
-    );
     touched.sort_unstable();
     touched.dedup();
     invariants::certify_manifold_at(&work.mesh, topo, &touched).map_err(fail)?;
@@ -142,15 +228,15 @@ fn certify_after_patch(
         "{pid}: the local manifold certificate passed, the whole-mesh one fails"
     );
     let cert = &mut state.counters.cert;
-    cert.manifold += 1;
+    cert.manifold += patches;
     invariants::certify_oriented(&work.mesh, topo).map_err(fail)?;
-    cert.oriented += 1;
+    cert.oriented += patches;
     ctx.signature
         .certify_same(&TopologySignature::of(topo))
         .map_err(fail)?;
-    cert.same_topology += 1;
+    cert.same_topology += patches;
     certify_boundary(ctx, state).map_err(fail)?;
-    state.counters.cert.boundary_preserved += 1;
+    state.counters.cert.boundary_preserved += patches;
     state.counters.times.certify += t0.elapsed().as_secs_f64();
     Ok(())
 }

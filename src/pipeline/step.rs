@@ -12,7 +12,7 @@ use super::chains::{self, PatchDomain};
 use super::context::{Counters, LoopState, RunContext};
 use super::debug::{write_candidate, write_debug};
 use super::error::{PipelineError, Stage, StageError};
-use super::records::{FailedAttempt, PatchRecord};
+use super::records::{FailedAttempt, Fallbacks, PatchRecord};
 use crate::fidelity::{self, PatchVertices, Refined, RoundOutput, RoundsSetup, VertexFactors};
 use crate::ids::{FaceId, PatchId};
 use crate::invariants::{self, InvariantError};
@@ -25,6 +25,7 @@ use crate::remesh2d::{
 };
 use crate::stitch::{Replacement, WorkingMesh};
 use nalgebra::{Matrix2, Matrix3};
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Smallest patch the retry ladder shrinks to before keeping the faces unchanged.
@@ -50,17 +51,73 @@ pub enum PatchOutcome {
     },
 }
 
-/// One patch through stages (b)–(e) with the retry ladder (module docs). The working mesh
-/// is not changed; the counters and the retry log are.
+/// Stages (b)–(e) for every patch of a batch ([`super::RemeshOptions::batch`]), at the same
+/// time (rayon): each patch reads the same working mesh and draws from its own RNG stream
+/// ([`patch_rng`]), so the outcomes, returned in batch order, do not depend on the thread
+/// count. The first error in batch order is the batch's.
+pub fn batch_steps(
+    ctx: &RunContext<'_>,
+    state: &LoopState,
+    batch: &[Patch],
+) -> Result<Vec<(PatchOutcome, StepLog)>, PipelineError> {
+    let step = |k: usize, patch: &Patch| {
+        let slot = state.patches + k;
+        let mut rng = patch_rng(ctx.plan.options.seed, slot);
+        patch_step(ctx, state, PatchId::new(slot), patch, &mut rng)
+    };
+    let results: Vec<_> = match batch {
+        [patch] => vec![step(0, patch)],
+        _ => batch
+            .par_iter()
+            .enumerate()
+            .map(|(k, p)| step(k, p))
+            .collect(),
+    };
+    results.into_iter().collect()
+}
+
+/// The RNG of the patch in slot `slot` of the loop (its id before deferrals): stream
+/// `slot + 1` of the run's seed (stream 0 is the patch strategy's).
+pub fn patch_rng(seed: u64, slot: usize) -> crate::Rng {
+    let mut rng = <crate::Rng as rand::SeedableRng>::seed_from_u64(seed);
+    rng.set_stream(slot as u64 + 1);
+    rng
+}
+
+/// What one patch's step did besides its outcome: its stage times and certificate counts and
+/// its retry log, merged into the run's in patch order ([`StepLog::merge_into`]) so that a
+/// batch's patches can run at the same time.
+#[derive(Default)]
+pub struct StepLog {
+    /// Times and certificates of this patch's attempts.
+    pub counters: Counters,
+    /// Its failed attempts, shrinks and kept faces.
+    pub fallbacks: Fallbacks,
+}
+
+impl StepLog {
+    /// Add this log to the run's state.
+    pub fn merge_into(self, state: &mut LoopState) {
+        state.counters.absorb(self.counters);
+        let f = &mut state.fallbacks;
+        f.shrinks += self.fallbacks.shrinks;
+        f.kept_faces += self.fallbacks.kept_faces;
+        f.failures.extend(self.fallbacks.failures);
+    }
+}
+
+/// One patch through stages (b)–(e) with the retry ladder (module docs). Reads the working
+/// mesh and changes nothing in it (so the patches of a batch can run at the same time): what
+/// it did goes into the returned [`StepLog`]. `pid` names the patch in records and errors.
 pub fn patch_step(
     ctx: &RunContext<'_>,
-    state: &mut LoopState,
+    state: &LoopState,
+    pid: PatchId,
     patch: &Patch,
     rng: &mut crate::Rng,
-) -> Result<PatchOutcome, PipelineError> {
-    let pid = PatchId::new(state.patches);
+) -> Result<(PatchOutcome, StepLog), PipelineError> {
     let seed = patch.seed_vertex;
-    let failures_before = state.fallbacks.failures.len();
+    let mut log = StepLog::default();
     let mut faces = patch.faces.clone();
     let mut outcome = loop {
         let unprocessed_in = faces
@@ -70,7 +127,7 @@ pub fn patch_step(
         if unprocessed_in == 0 {
             return Err(PipelineError::NoProgress { patch: pid, seed });
         }
-        certify_patch(ctx, state, pid, patch, &faces)?;
+        certify_patch(ctx, state, &mut log.counters, pid, patch, &faces)?;
         let record =
             |faces_out: usize, kept: bool, distortion, fidelity_rounds: usize| PatchRecord {
                 id: pid,
@@ -89,7 +146,7 @@ pub fn patch_step(
             topo: &state.topo,
             factors: &state.factors,
         };
-        match attempt(ctx, &view, &faces, rng, &mut state.counters) {
+        match attempt(ctx, &view, &faces, rng, &mut log.counters) {
             Ok((refined, distortion)) => {
                 let record = record(
                     refined.replacement.triangles.len(),
@@ -107,18 +164,18 @@ pub fn patch_step(
                 if ctx.plan.options.strict {
                     return Err(failure.into_error(ctx, pid, patch, &state.work, &faces));
                 }
-                state.fallbacks.failures.push(FailedAttempt {
+                log.fallbacks.failures.push(FailedAttempt {
                     patch: pid,
                     faces: faces.len(),
                     stage: failure.stage,
                     error: failure.error,
                 });
                 if faces.len() <= MIN_PATCH_FACES {
-                    state.fallbacks.kept_faces += unprocessed_in;
+                    log.fallbacks.kept_faces += unprocessed_in;
                     let record = record(faces.len(), true, DistortionReport::default(), 0);
                     break PatchOutcome::Kept { faces, record };
                 }
-                state.fallbacks.shrinks += 1;
+                log.fallbacks.shrinks += 1;
                 let target = faces.len() / 2;
                 faces = ctx.stages.patches.shrink(
                     &state.patch_context(ctx),
@@ -129,13 +186,13 @@ pub fn patch_step(
             }
         }
     };
-    let retries = state.fallbacks.failures.len() - failures_before;
+    let retries = log.fallbacks.failures.len();
     match &mut outcome {
         PatchOutcome::Remeshed { record, .. } | PatchOutcome::Kept { record, .. } => {
             record.retries = retries
         }
     }
-    Ok(outcome)
+    Ok((outcome, log))
 }
 
 /// The strategy's contract on one attempt's faces: a disk (the hard certificate: a strategy
@@ -143,7 +200,8 @@ pub fn patch_step(
 /// and no feature edge inside.
 fn certify_patch(
     ctx: &RunContext<'_>,
-    state: &mut LoopState,
+    state: &LoopState,
+    counters: &mut Counters,
     pid: PatchId,
     patch: &Patch,
     faces: &[FaceId],
@@ -156,7 +214,7 @@ fn certify_patch(
         violation: e,
         debug_file: write_debug(&ctx.plan.options, pid, "patch", &state.work.mesh, faces),
     })?;
-    state.counters.cert.disk += 1;
+    counters.cert.disk += 1;
     if let Some(vertex) = interior_corner(&state.work.mesh, &state.topo, faces, &ctx.corners) {
         return Err(PipelineError::CornerInterior {
             patch: pid,
@@ -174,7 +232,7 @@ fn certify_patch(
             edge,
         });
     }
-    state.counters.times.patches += t0.elapsed().as_secs_f64();
+    counters.times.patches += t0.elapsed().as_secs_f64();
     Ok(())
 }
 

@@ -108,6 +108,28 @@ pub fn triangle_quality_with_sqrt(p: [Point3<f64>; 3], q_t: &Matrix3<f64>) -> Tr
     TriangleQuality { q, angles }
 }
 
+/// The q of [`triangle_quality`] from the metric's inner products of the edges (eᵢᵀ M eⱼ)
+/// instead of the edges mapped by √M: the same number up to rounding (|Qa|² = aᵀMa, and
+/// |Qa × Qb|² = |Qa|²|Qb|² − (Qa·Qb)² for the area), without the eigen-decomposition. The
+/// surface passes score every candidate position and flip by it; what is reported is measured
+/// by [`triangle_quality`].
+pub fn triangle_q(p: [Point3<f64>; 3], m: &Matrix3<f64>) -> f64 {
+    let e = [p[1] - p[0], p[2] - p[1], p[0] - p[2]];
+    let dot = |a: &Vector3<f64>, b: &Vector3<f64>| 0.5 * (a.dot(&(m * b)) + b.dot(&(m * a)));
+    let len = e.map(|x| dot(&x, &x).max(0.0).sqrt());
+    let g01 = dot(&e[0], &e[1]);
+    let area = 0.5
+        * (len[0] * len[0] * len[1] * len[1] - g01 * g01)
+            .max(0.0)
+            .sqrt();
+    let h = len[0].max(len[1]).max(len[2]);
+    let semi = 0.5 * (len[0] + len[1] + len[2]);
+    if !(area.is_finite() && h.is_finite()) || len.contains(&0.0) || area == 0.0 {
+        return 0.0;
+    }
+    (2.0 * 3f64.sqrt() * area / (semi * h)).min(1.0)
+}
+
 /// M_t = (M₁ + M₂ + M₃)/3, the metric of a triangle (Sec. 3.3 "Vertex position update").
 pub fn face_metric(vertex_metrics: &[Matrix3<f64>], f: [VertexId; 3]) -> Matrix3<f64> {
     (vertex_metrics[f[0].idx()] + vertex_metrics[f[1].idx()] + vertex_metrics[f[2].idx()]) / 3.0
@@ -323,6 +345,35 @@ pub fn edge_conformity_where(
 
 #[cfg(test)]
 mod tests {
+
+    /// The inner-product q equals the √M one up to rounding, on random triangles in random
+    /// full-rank and rank-2 metrics (the curvature metric is rank 2) and on degenerate ones.
+    #[test]
+    fn inner_product_q_matches_the_mapped_q() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = crate::Rng::seed_from_u64(7);
+        let mut r = || rng.random_range(-1.0..1.0);
+        for k in 0..2000 {
+            let p = [0, 1, 2].map(|_| Point3::new(r(), r(), r()));
+            let a = nalgebra::Matrix3::from_fn(|_, _| r());
+            let mut m = a * a.transpose();
+            if k % 2 == 0 {
+                // Rank 2: zero along a random direction.
+                let n = Vector3::new(r(), r(), r()).normalize();
+                let proj = nalgebra::Matrix3::identity() - n * n.transpose();
+                m = proj * m * proj;
+            }
+            let want = super::triangle_quality(p, &m).q;
+            let got = super::triangle_q(p, &m);
+            assert!((want - got).abs() <= 1e-9, "case {k}: {want} vs {got}");
+        }
+        let flat = [
+            Point3::origin(),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(2.0, 0.0, 0.0),
+        ];
+        assert_eq!(super::triangle_q(flat, &nalgebra::Matrix3::identity()), 0.0);
+    }
     use super::*;
 
     #[test]

@@ -2,7 +2,7 @@
 //! metric length, triangulate it (spade's constrained Delaunay triangulation).
 
 use super::{Metric2d, PlanarDomain, Remesh2dError};
-use crate::invariants::point_in_polygon;
+use crate::invariants::PolygonSlabs;
 use nalgebra::Point2;
 use spade::{ConstrainedDelaunayTriangulation, Triangulation};
 use std::collections::HashMap;
@@ -92,8 +92,9 @@ pub fn triangulate_polygon_with(
         ));
     }
     let mut points: Vec<Point2<f64>> = boundary.to_vec();
+    let inside = PolygonSlabs::new(boundary);
     let kept: Vec<usize> = (0..interior.len())
-        .filter(|&i| point_in_polygon(boundary, &interior[i]) == Some(true))
+        .filter(|&i| inside.contains(&interior[i]) == Some(true))
         .collect();
     points.extend(kept.iter().map(|&i| interior[i]));
     let verts: Vec<spade::Point2<f64>> = points
