@@ -1,4 +1,8 @@
 //! `conemesh remesh`: Algorithm 1 end to end, with the report and the Table-1 row.
+//!
+//! The Python package (`python/src/lib.rs`) compiles this file too and calls [`options`],
+//! [`stages`], [`target`], [`progress_bar`] and [`peak_rss_mib`], so its keywords parse
+//! with these clap definitions and cannot drift from the CLI's defaults.
 
 use anyhow::Context;
 use conemesh::pipeline::{CoarseInput, Progress, RemeshOptions, Remesher, Stages};
@@ -371,7 +375,7 @@ fn check_output_paths(args: &RemeshArgs) -> anyhow::Result<()> {
 
 /// `--ltar` or `--ltar-factor`. A metric length is the same in file units and in unit space
 /// (`Normalization`).
-fn target(args: &RemeshArgs) -> TargetLength {
+pub fn target(args: &RemeshArgs) -> TargetLength {
     match args.ltar {
         Some(l) => TargetLength::Absolute(l),
         None => TargetLength::Factor(args.ltar_factor),
@@ -379,7 +383,7 @@ fn target(args: &RemeshArgs) -> TargetLength {
 }
 
 /// The options of Algorithm 1 from the arguments.
-fn options(args: &RemeshArgs) -> RemeshOptions {
+pub fn options(args: &RemeshArgs) -> RemeshOptions {
     RemeshOptions {
         seed: args.seed,
         target: target(args),
@@ -419,7 +423,7 @@ fn options(args: &RemeshArgs) -> RemeshOptions {
 
 /// The three extension points by registry name, with their options. With a user metric the
 /// planar remesher's `sizes` option defaults to true (absolute sizes), as in the library.
-fn stages(args: &RemeshArgs, user_metric: bool) -> anyhow::Result<Stages> {
+pub fn stages(args: &RemeshArgs, user_metric: bool) -> anyhow::Result<Stages> {
     let mut strategy = Params::parse(&args.strategy_opt)?;
     if let Some(r) = args.expand_rings {
         strategy.set("expand_rings", r);
@@ -502,7 +506,7 @@ fn improvers(args: &RemeshArgs) -> anyhow::Result<Vec<Box<dyn conemesh::improve:
         .collect()
 }
 
-fn progress_bar(quiet: bool, total: u64) -> ProgressBar {
+pub fn progress_bar(quiet: bool, total: u64) -> ProgressBar {
     if quiet {
         return ProgressBar::hidden();
     }
@@ -518,7 +522,7 @@ fn progress_bar(quiet: bool, total: u64) -> ProgressBar {
 
 /// This process's peak resident memory in MiB (`VmHWM` of `/proc/self/status`, in kB; `None`
 /// where there is no such file, i.e. off Linux).
-fn peak_rss_mib() -> Option<f64> {
+pub fn peak_rss_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
