@@ -114,6 +114,7 @@ def remesh_options() -> list[dict[str, Any]]:
     list of dict
         One dict per keyword, in the CLI's order: ``name`` (the keyword), ``flag`` (the CLI
         flag), ``kind`` (``"flag"``: a bool; ``"value"``: one value; ``"list"``: repeatable),
+        ``type`` (``"bool"``, ``"int"``, ``"float"``, ``"str"``, as the CLI's parser takes it),
         ``default`` (as the CLI prints it, a string, or ``None`` when the option is off
         unless given), ``choices`` and ``help`` (the CLI's text). ``--metric`` is not
         among them: it is :func:`remesh`'s third parameter, ``metric``.
@@ -176,12 +177,7 @@ def _typed_default(o: Mapping[str, Any]) -> Any:
         return False
     if d is None:
         return None
-    for t in (int, float):
-        try:
-            return t(d)
-        except ValueError:
-            pass
-    return d
+    return {"int": int, "float": float}.get(o["type"], str)(d)
 
 
 # ------------------------------------------------------------------ functions

@@ -183,7 +183,8 @@ fn write(
 // ---------------------------------------------------------------- remesh
 
 /// The keywords of `remesh`: every option of `conemesh remesh` but the input and `-o`, with
-/// its flag, kind (`flag`, `value`, `list`), default (as the CLI prints it), choices and help.
+/// its flag, kind (`flag`, `value`, `list`), value type (`bool`, `int`, `float`, `str`),
+/// default (as the CLI prints it), choices and help.
 #[pyfunction]
 fn remesh_options(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
     let cmd = RemeshCli::command();
@@ -216,6 +217,15 @@ fn remesh_options(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
             .iter()
             .map(|p| p.get_name().to_string())
             .collect();
+        // The value's type, asked of the option's own parser: a probe value it accepts.
+        let accepts = |v: &str| parse_args(&[format!("--{long}={v}")]).is_ok();
+        let ty = match kind {
+            "flag" => "bool",
+            _ if !choices.is_empty() || accepts("x") => "str",
+            _ if accepts("1") && !accepts("0.5") => "int",
+            _ => "float",
+        };
+        d.set_item("type", ty)?;
         d.set_item("choices", choices)?;
         d.set_item(
             "help",
