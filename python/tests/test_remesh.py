@@ -246,3 +246,19 @@ def test_ctrl_c_stops_a_run_cleanly(meshes):
     assert p.returncode == 0
     assert out.startswith("interrupted"), out
     assert time.monotonic() - t0 < 4.0  # the full run takes ~8 s
+
+
+def test_a_flipped_face_names_its_edges_and_an_unused_vertex_is_dropped(bumpy):
+    V, F = bumpy
+    flipped = F.copy()
+    flipped[10] = flipped[10][::-1]
+    with pytest.raises(conemesh.InputError) as e:
+        conemesh.remesh(V, flipped, quiet=True)
+    assert e.value.invariant == "inconsistent_orientation"
+    assert sorted(e.value.edges) == sorted(
+        tuple(sorted((int(a), int(b)))) for a, b in [F[10][[0, 1]], F[10][[1, 2]], F[10][[2, 0]]]
+    )
+    # A vertex no face uses changes nothing (the CLI drops it too).
+    U, G, _ = conemesh.remesh(np.vstack([V, [[5.0, 5.0, 5.0]]]), F, quiet=True)
+    U0, G0, _ = conemesh.remesh(V, F, quiet=True)
+    assert np.array_equal(U, U0) and np.array_equal(G, G0)
