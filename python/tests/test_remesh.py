@@ -226,7 +226,10 @@ def test_the_gil_is_released(meshes):
 def test_ctrl_c_stops_a_run_cleanly(meshes):
     script = textwrap.dedent(
         f"""
-        import sys, time, conemesh
+        import signal, sys, time, conemesh
+        # Python's own Ctrl-C handler, as in a terminal: a process started in the background
+        # by a non-interactive shell (CI) inherits SIGINT ignored, and Python then installs none.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         V, F = conemesh.read({str(meshes / "decimated-knight.off")!r})
         print("started", flush=True)
         t = time.monotonic()
