@@ -248,7 +248,7 @@ def remesh(V, F, metric=None, **options):
     args = _remesh_args(options)
     Va, Fa = _vertices(V), _faces(F)
     m_arr, m_path = _metric(metric)
-    U, G, report = _conemesh.remesh(Va, Fa, m_arr, m_path, args)
+    (U, G), report = _conemesh.remesh(Va, Fa, m_arr, m_path, args)
     return U, G, json.loads(report)
 
 
@@ -289,7 +289,7 @@ def read(path):
     -----
     What the reader had to fix or skip is issued as ``UserWarning``.
     """
-    V, F, notes = _conemesh.read(os.fspath(path))
+    (V, F), notes = _conemesh.read(os.fspath(path))
     for n in notes:
         warnings.warn(f"{os.fspath(path)}: {n}", stacklevel=2)
     return V, F

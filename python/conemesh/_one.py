@@ -23,7 +23,7 @@ def main(argv: list[str]) -> int:
 
     try:
         V, F = conemesh.read(input_path)
-        U, G, report = conemesh._conemesh.remesh(
+        (U, G), report = conemesh._conemesh.remesh(
             conemesh._vertices(V), conemesh._faces(F), None, None, args + ["--quiet"]
         )
         conemesh.write(output_path, U, G)

@@ -39,6 +39,9 @@ struct RemeshCli {
 
 type PyResultOf<T> = Result<T, Failure>;
 
+/// `(V, F)` as numpy arrays: `(n, 3)` float64 and `(m, 3)` int64.
+type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
+
 fn raise<T>(py: Python<'_>, r: PyResultOf<T>) -> PyResult<T> {
     r.map_err(|f| f.into_pyerr(py))
 }
@@ -143,24 +146,19 @@ fn metric_of(
 
 // ---------------------------------------------------------------- files
 
-/// `read(path) -> (V, F, warnings)`.
+/// `read(path) -> ((V, F), warnings)`.
 #[pyfunction]
-fn read<'py>(
-    py: Python<'py>,
-    path: PathBuf,
-) -> PyResult<(
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<i64>>,
-    Vec<String>,
-)> {
+fn read<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(MeshArrays<'py>, Vec<String>)> {
     let loaded = raise(
         py,
         py.detach(|| conemesh::io::read_mesh(&path).map_err(|e| errors::from_io(&e))),
     )?;
     let warnings = loaded.warnings.iter().map(|w| w.to_string()).collect();
     Ok((
-        positions_array(py, &loaded.mesh.positions),
-        faces_array(py, &loaded.mesh.triangles),
+        (
+            positions_array(py, &loaded.mesh.positions),
+            faces_array(py, &loaded.mesh.triangles),
+        ),
         warnings,
     ))
 }
@@ -393,10 +391,9 @@ fn remesh_job(
     })
 }
 
-/// `remesh(V, F, metric_array, metric_path, args) -> (V, F, report_json)`.
+/// `remesh(V, F, metric_array, metric_path, args) -> ((V, F), report_json)`.
 #[pyfunction]
 #[pyo3(signature = (v, f, metric_array, metric_path, args))]
-#[allow(clippy::type_complexity)]
 fn remesh<'py>(
     py: Python<'py>,
     v: PyReadonlyArray2<'py, f64>,
@@ -404,7 +401,7 @@ fn remesh<'py>(
     metric_array: Option<PyReadonlyArray3<'py, f64>>,
     metric_path: Option<PathBuf>,
     args: Vec<String>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>, String)> {
+) -> PyResult<(MeshArrays<'py>, String)> {
     let parsed = raise(py, parse_args(&args))?;
     let mesh = raise(py, mesh_of(&v, &f))?;
     let metric = raise(py, metric_of(metric_array, metric_path, mesh.n_vertices()))?;
@@ -423,8 +420,10 @@ fn remesh<'py>(
     });
     match result {
         Ok(out) => Ok((
-            positions_array(py, &out.mesh.positions),
-            faces_array(py, &out.mesh.triangles),
+            (
+                positions_array(py, &out.mesh.positions),
+                faces_array(py, &out.mesh.triangles),
+            ),
             out.report,
         )),
         Err(failure) => match (failure.class, interrupt) {
