@@ -1,4 +1,8 @@
 //! `conemesh remesh`: Algorithm 1 end to end, with the report and the Table-1 row.
+//!
+//! The Python package (`python/src/lib.rs`) compiles this file too and calls [`options`],
+//! [`stages`], [`target`], [`progress_bar`] and [`peak_rss_mib`], so its keywords parse
+//! with these clap definitions and cannot drift from the CLI's defaults.
 
 use anyhow::Context;
 use conemesh::pipeline::{CoarseInput, Progress, RemeshOptions, Remesher, Stages};
@@ -190,7 +194,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     let t_start = Instant::now();
     check_output_paths(&args)?;
     if let Some(n) = args.threads {
-        super::set_threads(n)?;
+        set_threads(n)?;
     }
     let (name, mesh) = match &args.mesh {
         Some(p) => {
@@ -384,7 +388,7 @@ fn check_output_paths(args: &RemeshArgs) -> anyhow::Result<()> {
 
 /// `--ltar` or `--ltar-factor`. A metric length is the same in file units and in unit space
 /// (`Normalization`).
-fn target(args: &RemeshArgs) -> TargetLength {
+pub fn target(args: &RemeshArgs) -> TargetLength {
     match args.ltar {
         Some(l) => TargetLength::Absolute(l),
         None => TargetLength::Factor(args.ltar_factor),
@@ -392,7 +396,7 @@ fn target(args: &RemeshArgs) -> TargetLength {
 }
 
 /// The options of Algorithm 1 from the arguments.
-fn options(args: &RemeshArgs) -> RemeshOptions {
+pub fn options(args: &RemeshArgs) -> RemeshOptions {
     RemeshOptions {
         seed: args.seed,
         target: target(args),
@@ -433,7 +437,7 @@ fn options(args: &RemeshArgs) -> RemeshOptions {
 
 /// The three extension points by registry name, with their options. With a user metric the
 /// planar remesher's `sizes` option defaults to true (absolute sizes), as in the library.
-fn stages(args: &RemeshArgs, user_metric: bool) -> anyhow::Result<Stages> {
+pub fn stages(args: &RemeshArgs, user_metric: bool) -> anyhow::Result<Stages> {
     let mut strategy = Params::parse(&args.strategy_opt)?;
     if let Some(r) = args.expand_rings {
         strategy.set("expand_rings", r);
@@ -516,7 +520,7 @@ fn improvers(args: &RemeshArgs) -> anyhow::Result<Vec<Box<dyn conemesh::improve:
         .collect()
 }
 
-fn progress_bar(quiet: bool, total: u64) -> ProgressBar {
+pub fn progress_bar(quiet: bool, total: u64) -> ProgressBar {
     if quiet {
         return ProgressBar::hidden();
     }
@@ -532,9 +536,18 @@ fn progress_bar(quiet: bool, total: u64) -> ProgressBar {
 
 /// This process's peak resident memory in MiB (`VmHWM` of `/proc/self/status`, in kB; `None`
 /// where there is no such file, i.e. off Linux).
-fn peak_rss_mib() -> Option<f64> {
+pub fn peak_rss_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb / 1024.0)
+}
+
+/// `--threads N`: the size of rayon's global pool (before any parallel work of the process).
+pub fn set_threads(n: usize) -> anyhow::Result<()> {
+    anyhow::ensure!(n >= 1, "--threads must be at least 1 (got {n})");
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build_global()
+        .map_err(|e| anyhow::anyhow!("cannot start {n} worker threads: {e}"))
 }

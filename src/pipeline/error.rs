@@ -195,6 +195,13 @@ pub enum PipelineError {
     /// Invalid input or options.
     #[error("{0}")]
     Input(String),
+    /// The run was stopped through [`super::Cancel`] (e.g. Ctrl-C in the Python package);
+    /// nothing is returned.
+    #[error("cancelled after {patches} patches")]
+    Cancelled {
+        /// patches done when the stop was seen
+        patches: usize,
+    },
     /// An improver failed with an error of its own.
     #[error("improver `{improver}`: {message}")]
     Improver {

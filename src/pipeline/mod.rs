@@ -43,7 +43,7 @@ mod step;
 
 pub use error::{PipelineError, Stage, StageError};
 pub use options::{
-    default_improvers, CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO,
+    default_improvers, Cancel, CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO,
     DEFAULT_IMPROVERS,
 };
 pub use records::{
@@ -86,8 +86,10 @@ pub fn remesh(
         replace::replace_batch(&ctx, &mut state, outcomes)?; // replace each P, update M
         state.batches += 1;
         on_progress(state.progress(&ctx));
+        options.cancel.check(state.patches)?;
     }
     state.loop_patches = state.patches;
+    options.cancel.check(state.patches)?;
     improvement::run(&ctx, &mut state, &mut rng)?; // Sec. 3.4, the improvers in order
     finish::certify_output(&ctx, &mut state)?;
     Ok(finish::into_result(&ctx, state))

@@ -10,6 +10,8 @@ use crate::registry::{Params, RegistryError};
 use crate::remesh2d::{Lct, PlanarRemesher, TransferMethod};
 use serde::Serialize;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 pub use crate::quality::TargetLength;
 
@@ -78,6 +80,36 @@ pub struct RemeshOptions {
     /// and the seed, never on the thread count. 1 = one patch at a time (the paper). Default
     /// [`DEFAULT_BATCH`].
     pub batch: usize,
+    /// Asks a running job to stop (e.g. Ctrl-C in the Python package); not an option of the
+    /// result, so it is not reported. Default: never set.
+    #[serde(skip)]
+    pub cancel: Cancel,
+}
+
+/// A stop request shared with another thread: [`super::remesh`] looks at it after every
+/// patch and before the improvers, and then ends with [`super::PipelineError::Cancelled`].
+/// Clones share the flag, so the caller keeps one and the options carry the other.
+#[derive(Clone, Debug, Default)]
+pub struct Cancel(Arc<AtomicBool>);
+
+impl Cancel {
+    /// Ask the run to stop at its next check.
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether [`Cancel::cancel`] was called.
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+
+    /// `Err(Cancelled)` once cancelled, naming how many patches were done.
+    pub fn check(&self, patches: usize) -> Result<(), super::PipelineError> {
+        match self.is_cancelled() {
+            true => Err(super::PipelineError::Cancelled { patches }),
+            false => Ok(()),
+        }
+    }
 }
 
 /// The default of [`RemeshOptions::batch`]: one patch at a time, until batches are shown to
@@ -121,6 +153,7 @@ impl Default for RemeshOptions {
             boundary: BoundaryOptions::default(),
             sizes: SizeOptions::default(),
             batch: DEFAULT_BATCH,
+            cancel: Cancel::default(),
         }
     }
 }
@@ -305,5 +338,28 @@ mod tests {
         let built: Vec<_> = default_improvers().iter().map(|i| i.name()).collect();
         assert_eq!(built, DEFAULT_IMPROVERS);
         assert_eq!(Stages::default().improver_names(), DEFAULT_IMPROVERS);
+    }
+
+    /// A stop asked from the progress callback ends the run after that patch, typed, and a
+    /// clone of the options shares the flag with the caller's copy.
+    #[test]
+    fn a_cancelled_run_stops_after_the_patch_that_saw_it() {
+        let options = RemeshOptions::default();
+        let stop = options.cancel.clone();
+        let mesh = crate::mesh::generators::plate(1.0, 6);
+        let mut seen = 0;
+        let result = super::super::Remesher::new(options).run_with(&mesh, None, |_| {
+            seen += 1;
+            stop.cancel();
+        });
+        assert!(
+            matches!(
+                result,
+                Err(super::super::PipelineError::Cancelled { patches: 1 })
+            ),
+            "expected Cancelled after 1 patch, got {:?}",
+            result.err()
+        );
+        assert_eq!(seen, 1);
     }
 }

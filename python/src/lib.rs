@@ -1,0 +1,641 @@
+//! `conemesh._conemesh`, the extension module of the Python package (issue 21). The public
+//! functions, their numpydoc and the keyword handling are in `conemesh/__init__.py`; this
+//! module takes checked numpy arrays and CLI-style argument lists and calls the library.
+//!
+//! `remesh` keywords become `conemesh remesh` flags, parsed by the CLI's own clap
+//! definitions and turned into options by the CLI's own builders (`src/cli/remesh.rs`,
+//! compiled here too), so a keyword's default is the flag's default by construction.
+//! Work runs with the GIL released; Ctrl-C is seen after each patch and stops the run
+//! through [`conemesh::pipeline::Cancel`].
+
+use clap::{ArgAction, CommandFactory, Parser};
+use conemesh::pipeline::{PipelineError, Progress, Remesher};
+use conemesh::quality::{EvalOptions, TargetLength};
+use conemesh::{TriMesh, VertexId};
+use errors::{Attr, Failure};
+use nalgebra::{Matrix3, Point3};
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadonlyArray3};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use std::time::Instant;
+
+mod errors;
+
+// Only the argument struct and the option builders are used here; `run` and the path
+// checks are the CLI's own.
+#[allow(dead_code)]
+#[path = "../../src/cli/remesh.rs"]
+mod cli_remesh;
+
+/// `conemesh remesh`'s arguments as their own command, as `src/main.rs` declares it.
+#[derive(Parser, Debug)]
+#[command(name = "conemesh remesh", allow_negative_numbers = true)]
+struct RemeshCli {
+    #[command(flatten)]
+    args: cli_remesh::RemeshArgs,
+}
+
+type PyResultOf<T> = Result<T, Failure>;
+
+/// `(V, F)` as numpy arrays: `(n, 3)` float64 and `(m, 3)` int64.
+type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
+
+fn raise<T>(py: Python<'_>, r: PyResultOf<T>) -> PyResult<T> {
+    r.map_err(|f| f.into_pyerr(py))
+}
+
+// ---------------------------------------------------------------- arrays
+
+/// `(n, 3)` float64 and `(m, 3)` int64 arrays (dtypes already coerced by the Python layer)
+/// as a [`TriMesh`], or an `InputError` naming the face or vertex.
+fn mesh_of(v: &PyReadonlyArray2<'_, f64>, f: &PyReadonlyArray2<'_, i64>) -> PyResultOf<TriMesh> {
+    let (v, f) = (v.as_array(), f.as_array());
+    if v.ncols() != 3 {
+        return Err(Failure::input(format!(
+            "V must have shape (n, 3), got {:?}",
+            v.shape()
+        )));
+    }
+    if f.ncols() != 3 {
+        return Err(Failure::input(format!(
+            "F must have shape (m, 3), got {:?}",
+            f.shape()
+        )));
+    }
+    let positions: Vec<Point3<f64>> = v
+        .rows()
+        .into_iter()
+        .map(|r| Point3::new(r[0], r[1], r[2]))
+        .collect();
+    let mut tris = Vec::with_capacity(f.nrows());
+    for (i, r) in f.rows().into_iter().enumerate() {
+        let mut t = [0usize; 3];
+        for k in 0..3 {
+            t[k] = usize::try_from(r[k]).map_err(|_| {
+                Failure::input(format!(
+                    "face f{i} references vertex index {}, which is negative",
+                    r[k]
+                ))
+                .with("faces", Attr::Ints(vec![i as i64]))
+                .with("index", Attr::Int(r[k]))
+            })?;
+        }
+        tris.push(t);
+    }
+    TriMesh::from_indices(positions, &tris).map_err(|e| errors::from_mesh(&e))
+}
+
+fn positions_array<'py>(py: Python<'py>, pts: &[Point3<f64>]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = pts.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+    // The shape is the vector's length by construction.
+    Array2::from_shape_vec((pts.len(), 3), flat)
+        .unwrap_or_else(|_| Array2::zeros((0, 3)))
+        .into_pyarray(py)
+}
+
+fn faces_array<'py>(py: Python<'py>, tris: &[[VertexId; 3]]) -> Bound<'py, PyArray2<i64>> {
+    let flat: Vec<i64> = tris.iter().flat_map(|t| t.map(|v| v.0 as i64)).collect();
+    Array2::from_shape_vec((tris.len(), 3), flat)
+        .unwrap_or_else(|_| Array2::zeros((0, 3)))
+        .into_pyarray(py)
+}
+
+/// A user metric: an `(n, 3, 3)` array of symmetric tensors (file units), or a `.sol` path.
+fn metric_of(
+    array: Option<PyReadonlyArray3<'_, f64>>,
+    path: Option<PathBuf>,
+    n_vertices: usize,
+) -> PyResultOf<Option<Vec<Matrix3<f64>>>> {
+    if let Some(p) = path {
+        return conemesh::io::sol::read_sol(&p, n_vertices)
+            .map(Some)
+            .map_err(|e| errors::from_sol(&e));
+    }
+    let Some(a) = array else { return Ok(None) };
+    let a = a.as_array();
+    if a.shape() != [n_vertices, 3, 3] {
+        return Err(Failure::new(
+            "MetricError",
+            format!(
+                "metric must have shape ({n_vertices}, 3, 3), one tensor per vertex, got {:?}",
+                a.shape()
+            ),
+        ));
+    }
+    let mut out = Vec::with_capacity(n_vertices);
+    for v in 0..n_vertices {
+        let m = Matrix3::from_fn(|i, j| a[[v, i, j]]);
+        let bad = |what: &str| {
+            Failure::new("MetricError", format!("metric at vertex v{v} {what}"))
+                .with("vertices", Attr::Ints(vec![v as i64]))
+        };
+        if m.iter().any(|x| !x.is_finite()) {
+            return Err(bad("has a NaN or infinite entry"));
+        }
+        // Relative: a metric in file units may have any scale.
+        let scale = m.abs().max().max(f64::MIN_POSITIVE);
+        if (m - m.transpose()).abs().max() > 1e-12 * scale {
+            return Err(bad("is not symmetric"));
+        }
+        out.push(m);
+    }
+    Ok(Some(out))
+}
+
+// ---------------------------------------------------------------- files
+
+/// `read(path) -> ((V, F), warnings)`.
+#[pyfunction]
+fn read<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(MeshArrays<'py>, Vec<String>)> {
+    let loaded = raise(
+        py,
+        py.detach(|| conemesh::io::read_mesh(&path).map_err(|e| errors::from_io(&e))),
+    )?;
+    let warnings = loaded.warnings.iter().map(|w| w.to_string()).collect();
+    Ok((
+        (
+            positions_array(py, &loaded.mesh.positions),
+            faces_array(py, &loaded.mesh.triangles),
+        ),
+        warnings,
+    ))
+}
+
+/// `write(path, V, F)`: the format by extension, written atomically.
+#[pyfunction]
+fn write(
+    py: Python<'_>,
+    path: PathBuf,
+    v: PyReadonlyArray2<'_, f64>,
+    f: PyReadonlyArray2<'_, i64>,
+) -> PyResult<()> {
+    let mesh = raise(py, mesh_of(&v, &f))?;
+    raise(
+        py,
+        py.detach(|| conemesh::io::write_mesh(&path, &mesh).map_err(|e| errors::from_io(&e))),
+    )
+}
+
+// ---------------------------------------------------------------- remesh
+
+/// The keywords of `remesh`: every option of `conemesh remesh` but the input and `-o`, with
+/// its flag, kind (`flag`, `value`, `list`), value type (`bool`, `int`, `float`, `str`),
+/// default (as the CLI prints it), choices and help.
+#[pyfunction]
+fn remesh_options(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    let cmd = RemeshCli::command();
+    let mut out = Vec::new();
+    for a in cmd.get_arguments() {
+        let (Some(long), false) = (a.get_long(), a.is_positional()) else {
+            continue;
+        };
+        let kind = match a.get_action() {
+            ArgAction::SetTrue => "flag",
+            ArgAction::Append => "list",
+            ArgAction::Set => "value",
+            _ => continue, // --help
+        };
+        let id = a.get_id().as_str();
+        if id == "output" {
+            continue; // the arrays are returned
+        }
+        let d = PyDict::new(py);
+        d.set_item("name", id)?;
+        d.set_item("flag", format!("--{long}"))?;
+        d.set_item("kind", kind)?;
+        let default: Option<String> = a
+            .get_default_values()
+            .first()
+            .map(|s| s.to_string_lossy().into_owned());
+        d.set_item("default", default)?;
+        let choices: Vec<String> = a
+            .get_possible_values()
+            .iter()
+            .map(|p| p.get_name().to_string())
+            .collect();
+        // The value's type, asked of the option's own parser: a probe value it accepts.
+        let accepts = |v: &str| parse_args(&[format!("--{long}={v}")]).is_ok();
+        let ty = match kind {
+            "flag" => "bool",
+            _ if !choices.is_empty() || accepts("x") => "str",
+            _ if accepts("1") && !accepts("0.5") => "int",
+            _ => "float",
+        };
+        d.set_item("type", ty)?;
+        d.set_item("choices", choices)?;
+        d.set_item(
+            "help",
+            a.get_long_help()
+                .or(a.get_help())
+                .map(|h| h.to_string())
+                .unwrap_or_default(),
+        )?;
+        out.push(d);
+    }
+    Ok(out)
+}
+
+/// clap's verdict on an argument list, in the keywords' words (`ltar_factor`, not
+/// `--ltar-factor <LTAR_FACTOR>`).
+fn parse_args(args: &[String]) -> PyResultOf<cli_remesh::RemeshArgs> {
+    let argv = std::iter::once("conemesh remesh".to_string()).chain(args.iter().cloned());
+    RemeshCli::try_parse_from(argv)
+        .map(|c| c.args)
+        .map_err(|e| {
+            let rendered = e.render().to_string();
+            let first = rendered
+                .lines()
+                .find(|l| l.starts_with("error:"))
+                .unwrap_or(rendered.as_str())
+                .trim_start_matches("error:")
+                .trim();
+            Failure::option(keywordify(first))
+        })
+}
+
+/// `'--ltar-factor <LTAR_FACTOR>'` → `'ltar_factor'`.
+fn keywordify(msg: &str) -> String {
+    let mut out = String::with_capacity(msg.len());
+    let mut rest = msg;
+    while let Some(i) = rest.find("--") {
+        out.push_str(&rest[..i]);
+        let tail = &rest[i + 2..];
+        let end = tail
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+            .unwrap_or(tail.len());
+        out.push_str(&tail[..end].replace('-', "_"));
+        let mut after = &tail[end..];
+        if let Some(v) = after.strip_prefix(" <") {
+            if let Some(j) = v.find('>') {
+                after = &v[j + 1..];
+            }
+        }
+        rest = after;
+    }
+    out.push_str(rest);
+    out
+}
+
+/// Check an argument list without running anything (`conemesh.batch` does so before it
+/// submits a task).
+#[pyfunction]
+fn check_remesh_args(py: Python<'_>, args: Vec<String>) -> PyResult<()> {
+    raise(py, parse_args(&args).map(|_| ()))
+}
+
+/// What a remesh returns across the GIL boundary.
+struct Remeshed {
+    mesh: TriMesh,
+    report: String,
+}
+
+/// The whole of `conemesh remesh` on arrays: the same options, stages, run and yardstick,
+/// so that the output mesh is the CLI's byte for byte for the same seed.
+fn remesh_job(
+    args: &cli_remesh::RemeshArgs,
+    mesh: &TriMesh,
+    metric: Option<&[Matrix3<f64>]>,
+    mut on_progress: impl FnMut(Progress) -> bool,
+) -> PyResultOf<Remeshed> {
+    let t_start = Instant::now();
+    if let Some(n) = args.threads {
+        // The CLI sizes the process's one rayon pool at start; a Python process may already
+        // have used it.
+        return Err(Failure::option(format!(
+            "threads={n}: set RAYON_NUM_THREADS before the first remesh instead (the package uses the process's thread pool; the output is the same for every count)"
+        )));
+    }
+    // The pipeline refuses a non-manifold input with a message; certify it here first so
+    // that the exception names the elements, in the caller's numbering.
+    let topo = conemesh::Topology::build(mesh);
+    conemesh::invariants::certify_manifold(mesh, &topo)
+        .and_then(|()| conemesh::invariants::certify_oriented(mesh, &topo))
+        .map_err(|e| {
+            errors::with_invariant(
+                Failure::input(format!("the input mesh is not an oriented manifold: {e}")),
+                &e,
+            )
+        })?;
+    let mut options = cli_remesh::options(args);
+    // The CLI writes offending patches beside its output; an array has no such folder.
+    options.debug_dir = args.debug_dir.clone();
+    let cancel = options.cancel.clone();
+    let stages = cli_remesh::stages(args, metric.is_some())
+        .map_err(|e| Failure::option(format!("{e:#}")))?;
+    let bar = cli_remesh::progress_bar(args.quiet, mesh.n_faces() as u64);
+    let result =
+        Remesher::new(options)
+            .with_stages(stages)
+            .run_with(mesh, metric, |p: Progress| {
+                bar.set_length(p.total as u64);
+                bar.set_position((p.total - p.unprocessed) as u64);
+                bar.set_message(format!("{} patches", p.patches));
+                if !on_progress(p) {
+                    cancel.cancel();
+                }
+            });
+    bar.finish_and_clear();
+    let out = result.map_err(|e| match e {
+        PipelineError::Cancelled { patches } => Failure::new(
+            "KeyboardInterrupt",
+            format!("remesh cancelled after {patches} patches"),
+        ),
+        e => errors::from_pipeline(&e),
+    })?;
+    let elapsed = t_start.elapsed().as_secs_f64();
+    // The yardstick of `conemesh remesh`, with its options.
+    let eval_opts = EvalOptions {
+        target: cli_remesh::target(args),
+        self_intersections: false, // certified exactly by the pipeline already
+        ..EvalOptions::default()
+    };
+    let eval = conemesh::quality::evaluate(
+        &out.input,
+        &out.mesh,
+        out.input_metric.as_deref(),
+        &eval_opts,
+    )
+    .map_err(|e| Failure::new("RemeshError", e.to_string()))?;
+    if let Some(p) = &args.write_metric {
+        conemesh::io::sol::write_sol(p, &out.output_metric(), false)
+            .map_err(|e| errors::from_sol(&e))?;
+    }
+    if let Some(dir) = &args.plots {
+        conemesh::report::write_quality_plots(
+            dir,
+            "remesh",
+            &[
+                ("input", &eval.input_quality),
+                ("output", &eval.output_quality),
+            ],
+        )
+        .map_err(|e| Failure::new("FileError", e.to_string()))?;
+    }
+    let r = &out.unit.report;
+    // The CLI's `--report` document, with the Table-1 line added.
+    let json = serde_json::json!({
+        "input": null,
+        "output": null,
+        "seconds": elapsed,
+        "peak_rss_mib": cli_remesh::peak_rss_mib(),
+        "run": r,
+        "eval": eval,
+        "table_header": conemesh::quality::EvalReport::table_header(),
+        "table_row": eval.table_row("remesh"),
+    });
+    let report =
+        serde_json::to_string(&json).map_err(|e| Failure::new("RemeshError", e.to_string()))?;
+    if let Some(p) = &args.report {
+        let pretty = serde_json::to_string_pretty(&json)
+            .map_err(|e| Failure::new("RemeshError", e.to_string()))?;
+        conemesh::io::write_bytes_atomic(p, pretty.as_bytes()).map_err(|e| errors::from_io(&e))?;
+    }
+    Ok(Remeshed {
+        mesh: out.mesh,
+        report,
+    })
+}
+
+/// `remesh(V, F, metric_array, metric_path, args) -> ((V, F), report_json)`.
+#[pyfunction]
+#[pyo3(signature = (v, f, metric_array, metric_path, args))]
+fn remesh<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'py, f64>,
+    f: PyReadonlyArray2<'py, i64>,
+    metric_array: Option<PyReadonlyArray3<'py, f64>>,
+    metric_path: Option<PathBuf>,
+    args: Vec<String>,
+) -> PyResult<(MeshArrays<'py>, String)> {
+    let parsed = raise(py, parse_args(&args))?;
+    let mesh = raise(py, mesh_of(&v, &f))?;
+    let metric = raise(py, metric_of(metric_array, metric_path, mesh.n_vertices()))?;
+    let mut interrupt: Option<PyErr> = None;
+    let result = py.detach(|| {
+        remesh_job(&parsed, &mesh, metric.as_deref(), |_| {
+            // Signals are Python's to deliver: take the GIL for a moment after each patch.
+            match Python::attach(|py| py.check_signals()) {
+                Ok(()) => true,
+                Err(e) => {
+                    interrupt = Some(e);
+                    false
+                }
+            }
+        })
+    });
+    match result {
+        Ok(out) => Ok((
+            (
+                positions_array(py, &out.mesh.positions),
+                faces_array(py, &out.mesh.triangles),
+            ),
+            out.report,
+        )),
+        Err(failure) => match (failure.class, interrupt) {
+            ("KeyboardInterrupt", Some(e)) => Err(e),
+            ("KeyboardInterrupt", None) => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
+                failure.message,
+            )),
+            _ => Err(failure.into_pyerr(py)),
+        },
+    }
+}
+
+// ---------------------------------------------------------------- eval, check, patches, param
+
+/// `conemesh eval` on arrays: the JSON report, with the Table-1 line.
+#[pyfunction]
+#[pyo3(signature = (v_in, f_in, v_out, f_out, metric_array, metric_path, ltar_factor, ltar, samples, seed, self_intersections, name))]
+#[allow(clippy::too_many_arguments)]
+fn evaluate(
+    py: Python<'_>,
+    v_in: PyReadonlyArray2<'_, f64>,
+    f_in: PyReadonlyArray2<'_, i64>,
+    v_out: PyReadonlyArray2<'_, f64>,
+    f_out: PyReadonlyArray2<'_, i64>,
+    metric_array: Option<PyReadonlyArray3<'_, f64>>,
+    metric_path: Option<PathBuf>,
+    ltar_factor: Option<f64>,
+    ltar: Option<f64>,
+    samples: usize,
+    seed: u64,
+    self_intersections: bool,
+    name: String,
+) -> PyResult<String> {
+    let input = raise(py, mesh_of(&v_in, &f_in))?;
+    let output = raise(py, mesh_of(&v_out, &f_out))?;
+    let metric = raise(py, metric_of(metric_array, metric_path, input.n_vertices()))?;
+    // The checks of `conemesh eval`, in the keywords' words.
+    let target = raise(
+        py,
+        match (ltar, ltar_factor) {
+            (Some(_), Some(_)) => Err(Failure::option(
+                "ltar and ltar_factor cannot be given together",
+            )),
+            (Some(l), None) if !(l > 0.0 && l.is_finite()) => {
+                Err(Failure::option(format!("ltar must be positive, got {l}")))
+            }
+            (Some(l), None) => Ok(TargetLength::Absolute(l)),
+            (None, f) => {
+                let f = f.unwrap_or(1.5);
+                match f > 0.0 && f.is_finite() {
+                    true => Ok(TargetLength::Factor(f)),
+                    false => Err(Failure::option(format!(
+                        "ltar_factor must be positive, got {f}"
+                    ))),
+                }
+            }
+        },
+    )?;
+    let opts = EvalOptions {
+        target,
+        samples,
+        seed,
+        self_intersections,
+        ..EvalOptions::default()
+    };
+    let report = py.detach(|| {
+        conemesh::quality::evaluate(&input, &output, metric.as_deref(), &opts).map_err(|e| match &e
+        {
+            conemesh::quality::EvalError::Metric(m) => errors::from_metric(m),
+            _ => Failure::option(e.to_string()),
+        })
+    });
+    let report = raise(py, report)?;
+    let json = serde_json::json!({
+        "report": report,
+        "table_header": conemesh::quality::EvalReport::table_header(),
+        "table_row": report.table_row(&name),
+    });
+    Ok(json.to_string())
+}
+
+/// `conemesh check --json` on arrays.
+#[pyfunction]
+fn check(
+    py: Python<'_>,
+    v: PyReadonlyArray2<'_, f64>,
+    f: PyReadonlyArray2<'_, i64>,
+    self_intersections: bool,
+) -> PyResult<String> {
+    let mesh = raise(py, mesh_of(&v, &f))?;
+    let opts = conemesh::check::CheckOptions { self_intersections };
+    let report = py.detach(|| conemesh::check::check_mesh(&mesh, &opts));
+    serde_json::to_string(&report)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))
+}
+
+/// `conemesh patches` on arrays: per-face patch ids and the per-patch statistics (JSON).
+#[pyfunction]
+fn patches<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'py, f64>,
+    f: PyReadonlyArray2<'py, i64>,
+    seed: u64,
+    strategy: String,
+    strategy_opt: Vec<String>,
+) -> PyResult<(Bound<'py, PyArray1<i64>>, String)> {
+    use rand::SeedableRng;
+    let mesh = raise(py, mesh_of(&v, &f))?;
+    let run = py.detach(|| {
+        // Built here: a strategy need not be `Sync`.
+        let params = conemesh::registry::Params::parse(&strategy_opt)
+            .map_err(|e| Failure::option(e.to_string()))?;
+        let strat = conemesh::patches::strategy(&strategy, params)
+            .map_err(|e| Failure::option(e.to_string()))?;
+        // The pipeline's working units (bounding-box diagonal 1), as `conemesh patches`.
+        let work = conemesh::metric::Normalization::of(&mesh).apply(&mesh);
+        let mut rng = conemesh::Rng::seed_from_u64(seed);
+        conemesh::patches::cover(
+            &work,
+            strat.as_ref(),
+            &conemesh::patches::CoverOptions::default(),
+            &mut rng,
+        )
+        .map_err(|e| Failure::new("RemeshError", e.to_string()))
+    });
+    let run = raise(py, run)?;
+    if !run.complete {
+        return Err(Failure::new(
+            "RemeshError",
+            format!(
+                "the `{}` strategy stopped after {} patches with faces still uncovered",
+                run.strategy,
+                run.patches.len()
+            ),
+        )
+        .into_pyerr(py));
+    }
+    let ids: Vec<i64> = run
+        .patch_of_face
+        .iter()
+        .map(|p| p.map_or(-1, |p| p.0 as i64))
+        .collect();
+    let stats = serde_json::json!({"strategy": run.strategy, "seed": seed, "stats": run.stats});
+    Ok((Array1::from(ids).into_pyarray(py), stats.to_string()))
+}
+
+/// `conemesh param` on arrays: uv per vertex (NaN for vertices no face uses) and the
+/// distortion report (JSON).
+#[pyfunction]
+fn param<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'py, f64>,
+    f: PyReadonlyArray2<'py, i64>,
+    method: String,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, String)> {
+    use conemesh::param::{disk_boundary, Parameterizer, SymmetricDirichlet, Tutte};
+    let full = raise(py, mesh_of(&v, &f))?;
+    let result = py.detach(|| {
+        // Built here: a parameterizer need not be `Sync`.
+        let p: Box<dyn Parameterizer> = match method.as_str() {
+            "sd" => Box::new(SymmetricDirichlet::default()),
+            "tutte" => Box::new(Tutte::default()),
+            other => {
+                return Err(Failure::option(format!(
+                    "method must be \"sd\" or \"tutte\", got {other:?}"
+                )))
+            }
+        };
+        let (mesh, map) = full.without_unreferenced_vertices();
+        let boundary = disk_boundary(&mesh).map_err(|e| Failure::input(e.to_string()))?;
+        let out = p
+            .parameterize(&mesh, &boundary)
+            .map_err(|e| Failure::new("RemeshError", e.to_string()))?;
+        // Re-check independently of the parameterizer, as `conemesh param` does.
+        conemesh::invariants::certify_bijective(&out.uv, &mesh.triangles, &boundary).map_err(
+            |e| errors::with_invariant(Failure::new("CertificateError", e.to_string()), &e),
+        )?;
+        let mut uv = vec![[f64::NAN; 2]; full.n_vertices()];
+        for (old, new) in map.iter().enumerate() {
+            if let Some(n) = new {
+                let q = out.uv[n.idx()];
+                uv[old] = [q.x, q.y];
+            }
+        }
+        let report = serde_json::json!({"method": p.name(), "distortion": out.report});
+        Ok::<_, Failure>((uv, report.to_string()))
+    });
+    let (uv, report) = raise(py, result)?;
+    let n = uv.len();
+    let arr = Array2::from_shape_vec((n, 2), uv.into_iter().flatten().collect())
+        .unwrap_or_else(|_| Array2::zeros((0, 2)));
+    Ok((arr.into_pyarray(py), report))
+}
+
+#[pymodule]
+fn _conemesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(write, m)?)?;
+    m.add_function(wrap_pyfunction!(remesh_options, m)?)?;
+    m.add_function(wrap_pyfunction!(check_remesh_args, m)?)?;
+    m.add_function(wrap_pyfunction!(remesh, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(patches, m)?)?;
+    m.add_function(wrap_pyfunction!(param, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
