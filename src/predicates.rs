@@ -191,6 +191,92 @@ fn projection_axis(p: &Point3<f64>, q: &Point3<f64>, r: &Point3<f64>) -> Option<
     })
 }
 
+/// `p` on the ray from `c` through `s`, given that `c, s, p` are collinear and `p, s ≠ c`:
+/// exact coordinate comparisons (the signs of `s − c` and `p − c` agree on both axes).
+fn same_direction(c: &Point2<f64>, s: &Point2<f64>, p: &Point2<f64>) -> bool {
+    s.x.total_cmp(&c.x) == p.x.total_cmp(&c.x) && s.y.total_cmp(&c.y) == p.y.total_cmp(&c.y)
+}
+
+/// The order of `p` and `q` met when turning counter-clockwise from the ray `c → s` (angles
+/// in `[0, 2π)`), exactly: the half-plane of each relative to that ray, then `orient2d`.
+fn ccw_order(
+    c: &Point2<f64>,
+    s: &Point2<f64>,
+    p: &Point2<f64>,
+    q: &Point2<f64>,
+) -> std::cmp::Ordering {
+    let class = |x: &Point2<f64>| match orient2d(c, s, x) {
+        Sign::Zero if same_direction(c, s, x) => 0,
+        Sign::Positive => 1,
+        Sign::Zero => 2,
+        Sign::Negative => 3,
+    };
+    let (kp, kq) = (class(p), class(q));
+    if kp != kq {
+        return kp.cmp(&kq);
+    }
+    match (kp, orient2d(c, p, q)) {
+        (0 | 2, _) | (_, Sign::Zero) => std::cmp::Ordering::Equal,
+        (_, Sign::Positive) => std::cmp::Ordering::Less,
+        (_, Sign::Negative) => std::cmp::Ordering::Greater,
+    }
+}
+
+/// Whether the non-degenerate triangles `(c, x, y)`, one per entry `[(x, key), (y, key)]` of
+/// `sectors`, all lie in one plane and meet only at `c` and along the edges `c → x` they share
+/// by key: their angular sectors at `c` are disjoint (a flat fan that winds at most once and
+/// does not fold), and two sectors touching along a ray end at the same key there. Decided
+/// exactly (`orient3d` for the plane, then `orient2d` in a projection the plane is not
+/// perpendicular to); `false` when any condition fails, including a degenerate triangle.
+/// Used to skip the pairs of such a fan in the self-intersection search: two of its faces
+/// sharing only `c` do not meet elsewhere.
+pub fn coplanar_fan_is_embedded<K: Copy + Eq>(
+    c: &Point3<f64>,
+    sectors: &[[(Point3<f64>, K); 2]],
+) -> bool {
+    let Some(first) = sectors.first() else {
+        return true;
+    };
+    let (a, b) = (first[0].0, first[1].0);
+    let Some((axis, _)) = projection_axis(c, &a, &b) else {
+        return false;
+    };
+    if sectors
+        .iter()
+        .flatten()
+        .any(|(p, _)| orient3d(c, &a, &b, p) != Sign::Zero)
+    {
+        return false;
+    }
+    let pc = project(c, axis);
+    let mut sec: Vec<[(Point2<f64>, K); 2]> = Vec::with_capacity(sectors.len());
+    for [(x, kx), (y, ky)] in sectors {
+        let (px, py) = (project(x, axis), project(y, axis));
+        match orient2d(&pc, &px, &py) {
+            Sign::Positive => sec.push([(px, *kx), (py, *ky)]),
+            Sign::Negative => sec.push([(py, *ky), (px, *kx)]),
+            Sign::Zero => return false,
+        }
+    }
+    let r0 = sec[0][0].0;
+    sec.sort_by(|s, t| ccw_order(&pc, &r0, &s[0].0, &t[0].0));
+    let m = sec.len();
+    if m == 1 {
+        return true;
+    }
+    (0..m).all(|k| {
+        let [(s, _), (e, ke)] = sec[k];
+        let (n, kn) = sec[(k + 1) % m][0];
+        let starts_apart = !(orient2d(&pc, &s, &n) == Sign::Zero && same_direction(&pc, &s, &n));
+        starts_apart
+            && match ccw_order(&pc, &s, &e, &n) {
+                std::cmp::Ordering::Less => true,
+                std::cmp::Ordering::Equal => ke == kn,
+                std::cmp::Ordering::Greater => false,
+            }
+    })
+}
+
 /// Closed 2D segment `[a, b]` against the closed non-degenerate triangle `t` whose
 /// orientation is `t_sign` (exact).
 fn segment_meets_triangle_2d(

@@ -113,3 +113,142 @@ fn output_paths_are_checked_before_any_work() {
     let back = conemesh::io::read_mesh(Path::new(&input)).expect("input intact");
     assert_eq!(back.mesh.n_faces(), 12 * 6 * 2);
 }
+
+/// Every file under `dir` whose name marks it as a temporary of `conemesh::io::Outputs`.
+fn temporaries(dir: &Path) -> Vec<String> {
+    let mut found = Vec::new();
+    for e in std::fs::read_dir(dir).expect("read dir") {
+        let p = e.expect("entry").path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if name.starts_with(conemesh::io::TEMP_PREFIX) {
+            found.push(p.display().to_string());
+        }
+        if p.is_dir() {
+            found.extend(temporaries(&p));
+        }
+    }
+    found
+}
+
+/// Issue 20, item 1: the outputs of `remesh` are one transaction. The last output (a plot)
+/// cannot be renamed into place (a folder of its name is in `--plots`): the mesh, the metric
+/// and the report written before it are undone, their old contents are back, the message
+/// names the plot, and no temporary remains.
+#[test]
+fn all_outputs_as_one_transaction_remesh_undoes_the_mesh_when_the_last_plot_fails() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = write_torus(dir.path());
+    let d = |n: &str| dir.path().join(n);
+    std::fs::write(d("out.obj"), b"old mesh").expect("write");
+    std::fs::write(d("report.json"), b"old report").expect("write");
+    std::fs::create_dir_all(d("plots/hist_min_angles.png")).expect("mkdir");
+    std::fs::write(d("plots/hist_q.png"), b"old plot").expect("write");
+    let s = |n: &str| d(n).to_str().unwrap().to_string();
+    let o = conemesh(&[
+        "remesh",
+        &input,
+        "-o",
+        &s("out.obj"),
+        "--report",
+        &s("report.json"),
+        "--write-metric",
+        &s("out.sol"),
+        "--plots",
+        &s("plots"),
+        "--quiet",
+        "--no-improve",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("hist_min_angles.png"), "{err}");
+    assert!(err.contains("none of them was written"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(std::fs::read(d("out.obj")).unwrap(), b"old mesh");
+    assert_eq!(std::fs::read(d("report.json")).unwrap(), b"old report");
+    assert_eq!(std::fs::read(d("plots/hist_q.png")).unwrap(), b"old plot");
+    assert!(!d("out.sol").exists());
+    assert!(!d("plots/hist_angles.png").exists());
+    assert!(d("plots/hist_min_angles.png").is_dir());
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+    // Without the obstacle the same run writes everything, and leaves no temporary either.
+    std::fs::remove_dir(d("plots/hist_min_angles.png")).expect("rmdir");
+    let o = conemesh(&[
+        "remesh",
+        &input,
+        "-o",
+        &s("out.obj"),
+        "--report",
+        &s("report.json"),
+        "--write-metric",
+        &s("out.sol"),
+        "--plots",
+        &s("plots"),
+        "--quiet",
+        "--no-improve",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mesh = conemesh::io::read_mesh(&d("out.obj")).expect("new mesh");
+    assert!(mesh.mesh.n_faces() > 0);
+    assert_ne!(std::fs::read(d("report.json")).unwrap(), b"old report");
+    assert!(d("out.sol").is_file() && d("plots/hist_min_angles.png").is_file());
+    assert_ne!(std::fs::read(d("plots/hist_q.png")).unwrap(), b"old plot");
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+}
+
+/// Issue 20, item 1, for `eval`: the JSON report and the plots are one transaction.
+#[test]
+fn all_outputs_as_one_transaction_eval_keeps_the_old_json_when_a_plot_fails() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = write_torus(dir.path());
+    let d = |n: &str| dir.path().join(n);
+    std::fs::write(d("r.json"), b"old json").expect("write");
+    std::fs::create_dir_all(d("plots/hist_angles.png")).expect("mkdir");
+    let o = conemesh(&[
+        "eval",
+        "--input",
+        &input,
+        "--output",
+        &input,
+        "--samples",
+        "1000",
+        "--json",
+        d("r.json").to_str().unwrap(),
+        "--plots",
+        d("plots").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("hist_angles.png"), "{err}");
+    assert_eq!(std::fs::read(d("r.json")).unwrap(), b"old json");
+    assert!(!d("plots/hist_q.png").exists());
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+}
+
+/// Plot folders whose parent folder does not exist, or under a regular file, are refused
+/// before any work (they used to fail after the mesh was written).
+#[test]
+fn a_plots_folder_under_a_file_or_a_missing_folder_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = write_torus(dir.path());
+    let out = dir.path().join("out.obj");
+    for plots in [
+        format!("{input}/plots"),
+        dir.path().join("no/plots").display().to_string(),
+    ] {
+        let o = conemesh(&[
+            "remesh",
+            &input,
+            "-o",
+            out.to_str().unwrap(),
+            "--plots",
+            &plots,
+        ]);
+        refused(&o, "--plots");
+        assert!(!out.exists());
+        let o = conemesh(&[
+            "eval", "--input", &input, "--output", &input, "--plots", &plots,
+        ]);
+        refused(&o, "--plots");
+    }
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+}

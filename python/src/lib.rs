@@ -23,6 +23,13 @@ use std::time::Instant;
 
 mod errors;
 
+// The path checks and the output commit `remesh.rs` calls as `super::…`.
+#[allow(dead_code)]
+#[path = "../../src/cli/outputs.rs"]
+mod cli_outputs;
+#[allow(unused_imports)]
+use cli_outputs::{check_file_output, check_plots_folder, commit, same_path};
+
 // Only the argument struct and the option builders are used here; `run` and the path
 // checks are the CLI's own.
 #[allow(dead_code)]

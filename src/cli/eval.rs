@@ -58,6 +58,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<ExitCode> {
             conemesh::quality::MAX_SAMPLES
         );
     }
+    check_output_paths(&args)?;
     let input = conemesh::io::read_mesh(&args.input)
         .with_context(|| format!("reading input {}", args.input.display()))?
         .mesh;
@@ -105,6 +106,8 @@ pub fn run(args: EvalArgs) -> anyhow::Result<ExitCode> {
     }
     println!("{}", report.table_row(&name));
 
+    // The JSON and the plots as one transaction (issue 20): both or neither.
+    let mut outputs = conemesh::io::Outputs::new();
     let mut plot_files = Vec::new();
     if let Some(dir) = &args.plots {
         let same = args.input == args.output;
@@ -116,8 +119,14 @@ pub fn run(args: EvalArgs) -> anyhow::Result<ExitCode> {
                 ("output", &report.output_quality),
             ]
         };
-        plot_files = conemesh::report::write_quality_plots(dir, &name, &series)
+        let staged = outputs
+            .dir(dir)
             .with_context(|| format!("writing plots to {}", dir.display()))?;
+        plot_files = conemesh::report::write_quality_plots(&staged, &name, &series)
+            .with_context(|| format!("writing plots to {}", dir.display()))?
+            .iter()
+            .filter_map(|p| p.file_name().map(|f| dir.join(f)))
+            .collect();
     }
     if let Some(path) = &args.json {
         let doc = serde_json::json!({
@@ -131,9 +140,11 @@ pub fn run(args: EvalArgs) -> anyhow::Result<ExitCode> {
             "wall_seconds": t0.elapsed().as_secs_f64(),
             "report": report,
         });
-        write_atomic(path, serde_json::to_string_pretty(&doc)?.as_bytes())
+        outputs
+            .bytes(path, serde_json::to_string_pretty(&doc)?.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }
+    super::commit(outputs)?;
     eprintln!(
         "L_avg {:.6}, L_tar {:.6} (unit space, diagonal 1); metric: {}; {:.2} s",
         report.l_avg,
@@ -144,15 +155,27 @@ pub fn run(args: EvalArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Write a file through a temporary file in the same folder, so a failure leaves no partial file.
-fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
-    use std::io::Write;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => std::path::Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
-    tmp.write_all(bytes)?;
-    tmp.persist(path)?;
+/// The output paths, checked before any work (issue 20): `--json` is not a folder and its
+/// folder exists, `--plots` is not a file and its parent exists, and `--json` is none of the
+/// inputs.
+fn check_output_paths(args: &EvalArgs) -> anyhow::Result<()> {
+    if let Some(p) = &args.json {
+        super::check_file_output("--json", p)?;
+        for (what, q) in [
+            Some(("--input", &args.input)),
+            Some(("--output", &args.output)),
+            args.metric.as_ref().map(|m| ("--metric", m)),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            if super::same_path(p, q) {
+                anyhow::bail!("--json {} is the same path as {what}", p.display());
+            }
+        }
+    }
+    if let Some(d) = &args.plots {
+        super::check_plots_folder("--plots", d)?;
+    }
     Ok(())
 }

@@ -9,3 +9,5 @@ pub mod patches;
 pub mod remesh;
 pub mod stages;
 
+mod outputs;
+pub use outputs::{check_file_output, check_plots_folder, commit, same_path};

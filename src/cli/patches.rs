@@ -1,7 +1,7 @@
 //! `conemesh patches [MESH] [--seed N] [--strategy NAME] [-o OUT.ply] [--json R.json]`:
 //! cover a mesh with certified disk patches (Sec. 3.2, no remeshing) and report them.
 
-use conemesh::io::{read_mesh, write_mesh_with, MeshAttributes, WriteOptions};
+use conemesh::io::{read_mesh, MeshAttributes, Outputs, WriteOptions};
 use conemesh::mesh::generators;
 use conemesh::metric::Normalization;
 use conemesh::patches::{cover, CoverOptions};
@@ -52,6 +52,22 @@ fn colour(i: usize) -> [u8; 3] {
 
 /// Run `conemesh patches`.
 pub fn run(args: PatchesArgs) -> anyhow::Result<ExitCode> {
+    let files: Vec<(&str, &PathBuf)> = [
+        args.output.as_ref().map(|p| ("-o", p)),
+        args.json.as_ref().map(|p| ("--json", p)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for (i, (flag, p)) in files.iter().enumerate() {
+        super::check_file_output(flag, p)?;
+        let earlier = files[..i].iter().map(|(f, q)| (*f, *q));
+        for (other, q) in earlier.chain(args.mesh.as_ref().map(|m| ("the input", m))) {
+            if super::same_path(p, q) {
+                anyhow::bail!("{flag} {} is the same path as {other}", p.display());
+            }
+        }
+    }
     let (mesh, name) = match &args.mesh {
         Some(p) => {
             let loaded =
@@ -87,6 +103,8 @@ pub fn run(args: PatchesArgs) -> anyhow::Result<ExitCode> {
         args.seed,
         secs
     );
+    // The mesh and the JSON as one transaction (issue 20): both or neither.
+    let mut outputs = Outputs::new();
     if let Some(out) = &args.output {
         // -1: a face no patch covered (only when the patch budget ran out).
         let ids: Vec<i64> = run
@@ -104,9 +122,9 @@ pub fn run(args: PatchesArgs) -> anyhow::Result<ExitCode> {
             ),
             ..Default::default()
         };
-        write_mesh_with(out, &mesh, &attrs, &WriteOptions::default())
+        outputs
+            .mesh(out, &mesh, &attrs, &WriteOptions::default())
             .map_err(|e| anyhow::anyhow!("cannot write the output mesh: {e}"))?;
-        println!("wrote {}", out.display());
     }
     if let Some(js) = &args.json {
         let report = serde_json::json!({
@@ -121,9 +139,18 @@ pub fn run(args: PatchesArgs) -> anyhow::Result<ExitCode> {
             "complete": run.complete,
             "stats": run.stats,
         });
-        conemesh::io::write_bytes_atomic(js, serde_json::to_string_pretty(&report)?.as_bytes())
+        outputs
+            .bytes(js, serde_json::to_string_pretty(&report)?.as_bytes())
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", js.display()))?;
-        println!("wrote {}", js.display());
+    }
+    let written: Vec<String> = outputs
+        .destinations()
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    super::commit(outputs)?;
+    for w in written {
+        println!("wrote {w}");
     }
     Ok(ExitCode::SUCCESS)
 }

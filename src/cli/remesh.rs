@@ -291,12 +291,22 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     for w in &out.warnings {
         eprintln!("warning: {w}");
     }
-    // Everything is computed; write the outputs (each atomically), the mesh first.
-    conemesh::io::write_mesh(&args.output, &out.mesh)
+    // Everything is computed; write the outputs as one transaction (issue 20): each is staged
+    // beside its destination and all are renamed into place only when all were written, so a
+    // failure leaves every destination as it was and no temporary behind.
+    let mut outputs = conemesh::io::Outputs::new();
+    outputs
+        .mesh(
+            &args.output,
+            &out.mesh,
+            &Default::default(),
+            &Default::default(),
+        )
         .with_context(|| format!("writing {}", args.output.display()))?;
-    println!("wrote {}", args.output.display());
     if let Some(p) = &args.write_metric {
-        conemesh::io::sol::write_sol(p, &out.output_metric(), false)
+        let bytes = conemesh::io::sol::sol_bytes(p, &out.output_metric(), false)?;
+        outputs
+            .bytes(p, &bytes)
             .with_context(|| format!("writing {}", p.display()))?;
     }
     if let Some(p) = &args.report {
@@ -308,12 +318,16 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             "run": r,
             "eval": eval,
         });
-        conemesh::io::write_bytes_atomic(p, serde_json::to_string_pretty(&json)?.as_bytes())
+        outputs
+            .bytes(p, serde_json::to_string_pretty(&json)?.as_bytes())
             .with_context(|| format!("writing {}", p.display()))?;
     }
     if let Some(dir) = &args.plots {
+        let staged = outputs
+            .dir(dir)
+            .with_context(|| format!("writing plots into {}", dir.display()))?;
         conemesh::report::write_quality_plots(
-            dir,
+            &staged,
             &short_name,
             &[
                 ("input", &eval.input_quality),
@@ -323,7 +337,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("writing plots into {}", dir.display()))?;
         if let Some(i) = &out.unit.report.improvement {
             conemesh::report::write_improvement_plot(
-                dir,
+                &staged,
                 &short_name,
                 &i.before.hist_min_angles,
                 &i.after.hist_min_angles,
@@ -332,11 +346,13 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("writing plots into {}", dir.display()))?;
         }
     }
+    super::commit(outputs)?;
+    println!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }
 
 /// Every output path, checked before any work (issue 20): each file's folder exists, no file
-/// output is a directory, `--plots` is not a regular file, and no two outputs (nor an output
+/// output is a directory, `--plots` is not a regular file and its folder exists, and no two outputs (nor an output
 /// and the input or the metric) are the same path.
 fn check_output_paths(args: &RemeshArgs) -> anyhow::Result<()> {
     let files: Vec<(&str, &PathBuf)> = [
@@ -348,27 +364,14 @@ fn check_output_paths(args: &RemeshArgs) -> anyhow::Result<()> {
     .flatten()
     .collect();
     for (flag, p) in &files {
-        if p.is_dir() {
-            anyhow::bail!("{flag} {}: is a directory, not a file", p.display());
-        }
-        let parent = p.parent().filter(|d| !d.as_os_str().is_empty());
-        if let Some(d) = parent.filter(|d| !d.is_dir()) {
-            anyhow::bail!(
-                "{flag} {}: folder {} does not exist",
-                p.display(),
-                d.display()
-            );
+        super::check_file_output(flag, p)?;
+    }
+    if let Some(d) = &args.plots {
+        super::check_plots_folder("--plots", d)?;
+        if let Some((flag, _)) = files.iter().find(|(_, p)| super::same_path(p, d)) {
+            anyhow::bail!("--plots {} is the same path as {flag}", d.display());
         }
     }
-    if let Some(d) = args.plots.as_ref().filter(|d| d.exists() && !d.is_dir()) {
-        anyhow::bail!("--plots {}: is a file, not a folder", d.display());
-    }
-    // Compared as absolute paths with `.` and `..` resolved where the file exists.
-    let key = |p: &PathBuf| {
-        std::fs::canonicalize(p)
-            .or_else(|_| std::path::absolute(p))
-            .unwrap_or_else(|_| p.clone())
-    };
     let inputs: Vec<(&str, &PathBuf)> = [
         args.mesh.as_ref().map(|p| ("the input", p)),
         args.metric.as_ref().map(|p| ("--metric", p)),
@@ -378,7 +381,7 @@ fn check_output_paths(args: &RemeshArgs) -> anyhow::Result<()> {
     .collect();
     for (i, (flag, p)) in files.iter().enumerate() {
         for (other, q) in files[..i].iter().chain(&inputs) {
-            if key(p) == key(q) {
+            if super::same_path(p, q) {
                 anyhow::bail!("{flag} {} is the same path as {other}", p.display());
             }
         }

@@ -10,10 +10,6 @@ use crate::predicates::{
     vertex_adjacent_triangles_intersect,
 };
 use nalgebra::Point3;
-use parry3d_f64::bounding_volume::Aabb;
-use parry3d_f64::math::Vector;
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
-use rayon::prelude::*;
 use std::collections::HashSet;
 
 /// Vertices whose incident faces do not form a single fan: the faces around `v`, linked when
@@ -202,98 +198,18 @@ pub fn faces_intersect(mesh: &TriMesh, f: FaceId, g: FaceId) -> bool {
     }
 }
 
-fn face_aabb(p: &[Point3<f64>; 3]) -> Aabb {
-    let lo = Vector::new(
-        p[0].x.min(p[1].x).min(p[2].x),
-        p[0].y.min(p[1].y).min(p[2].y),
-        p[0].z.min(p[1].z).min(p[2].z),
-    );
-    let hi = Vector::new(
-        p[0].x.max(p[1].x).max(p[2].x),
-        p[0].y.max(p[1].y).max(p[2].y),
-        p[0].z.max(p[1].z).max(p[2].z),
-    );
-    Aabb::new(lo, hi)
-}
-
-#[inline]
-fn boxes_overlap(a: &Aabb, b: &Aabb) -> bool {
-    // Closed boxes: touching counts (touching triangles intersect).
-    a.mins.x <= b.maxs.x
-        && b.mins.x <= a.maxs.x
-        && a.mins.y <= b.maxs.y
-        && b.mins.y <= a.maxs.y
-        && a.mins.z <= b.maxs.z
-        && b.mins.z <= a.maxs.z
-}
-
 /// Self-intersecting face pairs `(f, g)`, `f < g`, sorted; a degenerate face `f` is reported
 /// as the pair `(f, f)` and takes no further part (CGAL's convention: a zero-area face is a
-/// self-intersection by itself, and it has no plane to test against).
+/// self-intersection by itself, and it has no plane to test against). The verdict of every
+/// other pair is [`faces_intersect`]'s.
 ///
-/// Broad phase: a bounding-volume hierarchy (`parry3d_f64::partitioning::Bvh`) over the
-/// faces' axis-aligned boxes; each face queries it in parallel (rayon) and keeps the
-/// candidates with a larger id whose closed boxes overlap. The boxes are the exact min/max
-/// of the coordinates and compared with `<=`, so no intersecting pair is lost. Narrow phase:
-/// [`faces_intersect`]. The output is sorted, hence independent of thread scheduling.
+/// The search (`invariants/pairs.rs`) runs one exact query per edge of the mesh against a
+/// hierarchy of exact face boxes that prunes the faces sharing an endpoint of the edge, so
+/// fans of long thin faces cost about linear time, and it is parallel (rayon) from 1,024
+/// faces on. The output is sorted, hence independent of thread scheduling.
 pub fn self_intersections(mesh: &TriMesh) -> Vec<(FaceId, FaceId)> {
-    // Small meshes (the local checks after every patch, flip and move of Algorithm 1) run on
-    // the calling thread: waking rayon's workers for a few dozen faces cost more than the
-    // test itself. The result is sorted, so it does not depend on the path taken.
-    let parallel = mesh.n_faces() >= PARALLEL_MIN_FACES;
-    let degenerate: Vec<bool> = if parallel {
-        mesh.faces()
-            .collect::<Vec<_>>()
-            .par_iter()
-            .map(|&f| is_degenerate(mesh, f))
-            .collect()
-    } else {
-        mesh.faces().map(|f| is_degenerate(mesh, f)).collect()
-    };
-    let boxes: Vec<Aabb> = mesh
-        .faces()
-        .map(|f| face_aabb(&mesh.face_points(f)))
-        .collect();
-    // Leaves are numbered densely (parry's builder assumes leaf ids 0 and 1 when it has only
-    // one or two leaves), then mapped back to face ids.
-    let leaf_face: Vec<usize> = (0..mesh.n_faces()).filter(|&i| !degenerate[i]).collect();
-    let bvh = Bvh::from_leaves(
-        BvhBuildStrategy::Binned,
-        &leaf_face.iter().map(|&i| boxes[i]).collect::<Vec<_>>(),
-    );
-    let pairs_of = |i: usize| {
-        let mut found = Vec::new();
-        if degenerate[i] {
-            found.push((FaceId::new(i), FaceId::new(i)));
-            return found;
-        }
-        for leaf in bvh.intersect_aabb(&boxes[i]) {
-            let Some(&j) = leaf_face.get(leaf as usize) else {
-                continue;
-            };
-            if j <= i || !boxes_overlap(&boxes[i], &boxes[j]) {
-                continue;
-            }
-            if faces_intersect(mesh, FaceId::new(i), FaceId::new(j)) {
-                found.push((FaceId::new(i), FaceId::new(j)));
-            }
-        }
-        found
-    };
-    let mut pairs: Vec<(FaceId, FaceId)> = if parallel {
-        (0..mesh.n_faces())
-            .into_par_iter()
-            .flat_map_iter(pairs_of)
-            .collect()
-    } else {
-        (0..mesh.n_faces()).flat_map(pairs_of).collect()
-    };
-    pairs.sort_unstable();
-    pairs
+    super::pairs::self_intersections_with_stats(mesh).0
 }
-
-/// Below this many faces [`self_intersections`] does not use rayon.
-const PARALLEL_MIN_FACES: usize = 1024;
 
 /// No two faces intersect other than in their shared vertices and edges, and no face is
 /// degenerate (see [`self_intersections`]).
@@ -466,29 +382,6 @@ pub fn certify_boundary_kept(
 
 #[cfg(test)]
 mod tests {
-    #[test]
-    fn boxes_overlap_needs_overlap_on_every_axis() {
-        let b = |lo: [f64; 3], hi: [f64; 3]| {
-            Aabb::new(
-                parry3d_f64::math::Vector::new(lo[0], lo[1], lo[2]),
-                parry3d_f64::math::Vector::new(hi[0], hi[1], hi[2]),
-            )
-        };
-        let unit = b([0.0; 3], [1.0; 3]);
-        assert!(
-            boxes_overlap(&unit, &b([1.0, 0.5, 0.5], [2.0, 2.0, 2.0])),
-            "touching counts"
-        );
-        for axis in 0..3 {
-            let mut lo = [0.25; 3];
-            let mut hi = [0.75; 3];
-            lo[axis] = 1.5;
-            hi[axis] = 2.0;
-            assert!(!boxes_overlap(&unit, &b(lo, hi)), "apart along axis {axis}");
-            assert!(!boxes_overlap(&b(lo, hi), &unit), "apart along axis {axis}");
-        }
-    }
-
     use super::*;
     use crate::mesh::generators;
 
@@ -706,7 +599,10 @@ mod tests {
             );
             m.triangles
                 .extend(b.triangles.iter().map(|t| t.map(|v| VertexId(v.0 + n))));
-            assert_eq!(m.n_faces() >= PARALLEL_MIN_FACES, parallel);
+            assert_eq!(
+                m.n_faces() >= super::super::pairs::PARALLEL_MIN_FACES,
+                parallel
+            );
             let fast = self_intersections(&m);
             let mut slow = Vec::new();
             for i in 0..m.n_faces() {

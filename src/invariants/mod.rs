@@ -8,6 +8,7 @@
 //! remeshing).
 
 pub mod mesh;
+pub mod pairs;
 
 pub use mesh::{
     boundary_edges, certify_boundary_kept, certify_boundary_preserved, certify_manifold,

@@ -10,10 +10,13 @@
 mod medit;
 mod obj;
 mod off;
+mod outputs;
 mod ply;
 pub mod sol;
 mod stl;
 mod text;
+
+pub use outputs::{Outputs, TEMP_PREFIX};
 
 use crate::mesh::{MeshError, TriMesh};
 use nalgebra::{Point2, Point3};
@@ -333,6 +336,7 @@ pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<(), IoError> {
 /// Write a mesh with attributes and encoding options, atomically: the bytes go to a temporary
 /// file in the target directory, which is renamed over `path` only once complete, so that a
 /// failure leaves no partial output. The mesh is validated first ([`TriMesh::validate`]).
+/// Several outputs written as one transaction: [`Outputs::mesh`].
 ///
 /// Precision: text formats and binary PLY store `f64` exactly (text uses Rust's shortest
 /// round-trip `Display`); binary STL stores `f32` by definition of the format, so each
@@ -343,6 +347,19 @@ pub fn write_mesh_with(
     attrs: &MeshAttributes,
     opts: &WriteOptions,
 ) -> Result<(), IoError> {
+    let mut out = Outputs::new();
+    out.mesh(path, mesh, attrs, opts)?;
+    out.commit()
+}
+
+/// The writer of `mesh` in the format of `path`'s extension, after validating the mesh and
+/// its attributes.
+fn mesh_writer<'a>(
+    path: &Path,
+    mesh: &'a TriMesh,
+    attrs: &'a MeshAttributes,
+    opts: &'a WriteOptions,
+) -> Result<impl FnOnce(&mut dyn Write) -> std::io::Result<()> + 'a, IoError> {
     let p = path.display().to_string();
     let format =
         Format::from_path(path).ok_or_else(|| IoError::UnsupportedFormat { path: p.clone() })?;
@@ -351,7 +368,7 @@ pub fn write_mesh_with(
         source,
     })?;
     check_attributes(mesh, attrs, &p)?;
-    write_atomic(path, |w| match format {
+    Ok(move |w: &mut dyn Write| match format {
         Format::Obj => obj::write(w, mesh, attrs),
         Format::Off => off::write(w, mesh),
         Format::Ply => ply::write(w, mesh, attrs, opts),
@@ -404,45 +421,9 @@ fn check_attributes(mesh: &TriMesh, attrs: &MeshAttributes, path: &str) -> Resul
 /// Write `bytes` to `path` atomically (temporary file beside it, then rename), e.g. a JSON
 /// report: a failure leaves no partial file.
 pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
-    write_atomic(path, |w| w.write_all(bytes))
-}
-
-/// Write through `body` into a temporary file beside `path`, then rename it to `path`.
-/// On any error the temporary file is removed (dropped) and `path` is left untouched.
-fn write_atomic(
-    path: &Path,
-    body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<(), IoError> {
-    let p = path.display().to_string();
-    let os = |error: std::io::Error| IoError::Os {
-        path: p.clone(),
-        error,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".conemesh-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(os)?;
-    {
-        let mut w = std::io::BufWriter::new(tmp.as_file_mut());
-        body(&mut w).map_err(os)?;
-        w.flush().map_err(os)?;
-    }
-    tmp.as_file().sync_all().map_err(os)?;
-    #[cfg(unix)]
-    {
-        // tempfile creates 0600; give the result the usual permissions of a new file.
-        use std::os::unix::fs::PermissionsExt;
-        let _ = tmp
-            .as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    tmp.persist(path).map_err(|e| os(e.error))?;
-    Ok(())
+    let mut out = Outputs::new();
+    out.bytes(path, bytes)?;
+    out.commit()
 }
 
 /// Faces as read from a file, before triangulation: flat 0-based indices, one entry per face

@@ -16,7 +16,6 @@
 //! tangent plane is checked against the mesh by [`crate::metric::MetricField::new`].
 
 use nalgebra::Matrix3;
-use std::io::Write;
 use std::path::Path;
 use thiserror::Error;
 
@@ -419,30 +418,38 @@ fn six(m: &Matrix3<f64>) -> [f64; 6] {
 /// (a temporary file in the same directory, renamed over `path`). Only the upper triangle is
 /// stored; a non-finite entry is [`SolError::NaN`] and nothing is written.
 pub fn write_sol(path: &Path, metrics: &[Matrix3<f64>], binary: bool) -> Result<(), SolError> {
-    let p = path.display().to_string();
+    let bytes = sol_bytes(path, metrics, binary)?;
+    let mut out = super::Outputs::new();
+    let io = |e: super::IoError| match e {
+        super::IoError::Os { path, error } => SolError::Io {
+            path,
+            source: error,
+        },
+        other => SolError::Io {
+            path: path.display().to_string(),
+            source: std::io::Error::other(other.to_string()),
+        },
+    };
+    out.bytes(path, &bytes).map_err(io)?;
+    out.commit().map_err(io)
+}
+
+/// The bytes [`write_sol`] writes to `path` (named in the error of a non-finite entry), for
+/// staging with other outputs ([`super::Outputs`]).
+pub fn sol_bytes(path: &Path, metrics: &[Matrix3<f64>], binary: bool) -> Result<Vec<u8>, SolError> {
     for (v, m) in metrics.iter().enumerate() {
         if !six(m).iter().all(|x| x.is_finite()) {
-            return Err(SolError::NaN { path: p, vertex: v });
+            return Err(SolError::NaN {
+                path: path.display().to_string(),
+                vertex: v,
+            });
         }
     }
-    let bytes = if binary {
+    Ok(if binary {
         binary_bytes(metrics)
     } else {
         ascii_bytes(metrics)
-    };
-    let io = |source: std::io::Error| SolError::Io {
-        path: p.clone(),
-        source,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(&dir).map_err(io)?;
-    tmp.write_all(&bytes).map_err(io)?;
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    })
 }
 
 fn ascii_bytes(metrics: &[Matrix3<f64>]) -> Vec<u8> {
