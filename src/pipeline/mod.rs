@@ -82,7 +82,7 @@ pub fn remesh(
     let mut rng = crate::Rng::seed_from_u64(plan.options.seed);
     while state.face_remains(&ctx) {
         let batch = next_batch(&ctx, &mut state, &mut rng)?; // (a) Sec. 3.2, a vertex apart
-        let outcomes = step::batch_steps(&ctx, &state, &batch)?; // (b)-(e), at the same time
+        let outcomes = step::batch_steps(&ctx, &state, &batch, &mut rng)?; // (b)-(e), at the same time
         replace::replace_batch(&ctx, &mut state, outcomes)?; // replace each P, update M
         state.batches += 1;
         on_progress(state.progress(&ctx));

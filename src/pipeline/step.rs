@@ -54,12 +54,22 @@ pub enum PatchOutcome {
 /// Stages (b)–(e) for every patch of a batch ([`super::RemeshOptions::batch`]), at the same
 /// time (rayon): each patch reads the same working mesh and draws from its own RNG stream
 /// ([`patch_rng`]), so the outcomes, returned in batch order, do not depend on the thread
-/// count. The first error in batch order is the batch's.
+/// count. With batches of one patch, `rng` (the strategy's stream) is drawn instead. The first error in batch order is the batch's.
 pub fn batch_steps(
     ctx: &RunContext<'_>,
     state: &LoopState,
     batch: &[Patch],
+    rng: &mut crate::Rng,
 ) -> Result<Vec<(PatchOutcome, StepLog)>, PipelineError> {
+    if ctx.plan.options.batch == 1 {
+        // One patch at a time: the run's one stream, drawn by the strategy and the remesher in
+        // patch order (the paper's loop, and this crate's outputs before batches).
+        let pid = PatchId::new(state.patches);
+        return batch
+            .iter()
+            .map(|p| patch_step(ctx, state, pid, p, rng))
+            .collect();
+    }
     let step = |k: usize, patch: &Patch| {
         let slot = state.patches + k;
         let mut rng = patch_rng(ctx.plan.options.seed, slot);
