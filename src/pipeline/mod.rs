@@ -44,7 +44,7 @@ mod step;
 pub use error::{PipelineError, Stage, StageError};
 pub use options::{
     default_improvers, Cancel, CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO,
-    DEFAULT_IMPROVERS,
+    DEFAULT_BATCH, DEFAULT_IMPROVERS,
 };
 pub use records::{
     AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,
