@@ -353,18 +353,8 @@ fn remesh_job(
     })?;
     let elapsed = t_start.elapsed().as_secs_f64();
     // The yardstick of `conemesh remesh`, with its options.
-    let eval_opts = EvalOptions {
-        target: cli_remesh::target(args),
-        self_intersections: false, // certified exactly by the pipeline already
-        ..EvalOptions::default()
-    };
-    let eval = conemesh::quality::evaluate(
-        &out.input,
-        &out.mesh,
-        out.input_metric.as_deref(),
-        &eval_opts,
-    )
-    .map_err(|e| Failure::new("RemeshError", e.to_string()))?;
+    let eval = cli_remesh::evaluate_output(args, &out)
+        .map_err(|e| Failure::new("RemeshError", e.to_string()))?;
     if let Some(p) = &args.write_metric {
         conemesh::io::sol::write_sol(p, &out.output_metric(), false)
             .map_err(|e| errors::from_sol(&e))?;

@@ -234,18 +234,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         None => format!("remeshing {name}"),
     })?;
     let elapsed = t_start.elapsed().as_secs_f64();
-    // The yardstick, independent of the remesher: `conemesh eval` on the output.
-    let eval_opts = EvalOptions {
-        target: target(&args),
-        self_intersections: false, // certified exactly by the pipeline already
-        ..EvalOptions::default()
-    };
-    let eval = conemesh::quality::evaluate(
-        &out.input,
-        &out.mesh,
-        out.input_metric.as_deref(),
-        &eval_opts,
-    )?;
+    let eval = evaluate_output(&args, &out)?;
     let r = &out.unit.report;
     println!(
         "{name}: {} faces → {} faces in {} patches, {elapsed:.2} s",
@@ -553,4 +542,23 @@ pub fn set_threads(n: usize) -> anyhow::Result<()> {
         .num_threads(n)
         .build_global()
         .map_err(|e| anyhow::anyhow!("cannot start {n} worker threads: {e}"))
+}
+
+/// The yardstick, independent of the remesher: `conemesh eval` on a run's output against its
+/// input, at the run's target (shared with the Python package).
+pub fn evaluate_output(
+    args: &RemeshArgs,
+    out: &conemesh::pipeline::Remeshed,
+) -> Result<conemesh::quality::EvalReport, conemesh::quality::EvalError> {
+    let eval_opts = EvalOptions {
+        target: target(args),
+        self_intersections: false, // certified exactly by the pipeline already
+        ..EvalOptions::default()
+    };
+    conemesh::quality::evaluate(
+        &out.input,
+        &out.mesh,
+        out.input_metric.as_deref(),
+        &eval_opts,
+    )
 }

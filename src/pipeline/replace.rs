@@ -4,7 +4,7 @@
 use super::context::{a_priori_at, LoopState, RunContext};
 use super::debug::write_debug;
 use super::error::{PipelineError, Stage, StageError};
-use super::records::{FailedAttempt, PatchRecord};
+use super::records::FailedAttempt;
 use super::step::{PatchOutcome, StepLog};
 use crate::fidelity::Refined;
 use crate::ids::{FaceId, PatchId, VertexId};
@@ -66,7 +66,7 @@ pub fn replace_batch(
         }
     }
     let first_id = state.patches;
-    let mut remeshed: Vec<(PatchId, Vec<FaceId>, Refined, PatchRecord)> = Vec::new();
+    let mut remeshed: Vec<(PatchId, Vec<FaceId>, Refined, VertexId)> = Vec::new();
     let mut kept_faces: Vec<FaceId> = Vec::new();
     let mut records = Vec::new();
     for (k, (outcome, mut log)) in outcomes.into_iter().enumerate() {
@@ -99,8 +99,8 @@ pub fn replace_batch(
                 mut record,
             } => {
                 record.id = pid;
-                records.push(record.clone());
-                remeshed.push((pid, faces, refined, record));
+                remeshed.push((pid, faces, refined, record.seed));
+                records.push(record);
             }
             PatchOutcome::Kept { faces, mut record } => {
                 record.id = pid;
@@ -132,7 +132,7 @@ pub fn replace_batch(
             let r = &remeshed[0];
             return Err(PipelineError::Stage {
                 patch: r.0,
-                seed: Some(r.3.seed),
+                seed: Some(r.3),
                 stage: Stage::Stitching,
                 source: e.into(),
             });
@@ -147,7 +147,7 @@ pub fn replace_batch(
             .sum::<usize>();
     let gone: Vec<FaceId> = remeshed.iter().flat_map(|r| r.1.iter().copied()).collect();
     drop_provenance(&mut state.face_patch, &gone);
-    for ((pid, _, refined, record), faces) in remeshed.into_iter().zip(&new_faces) {
+    for ((pid, _, refined, seed), faces) in remeshed.into_iter().zip(&new_faces) {
         n += refined.replacement.new_positions.len();
         for (k, loc) in refined.replacement.new_locations.iter().enumerate() {
             let rounds = refined.factors.new.get(k).copied().unwrap_or(1.0);
@@ -160,7 +160,7 @@ pub fn replace_batch(
             .absorb(refined.factors, ctx.plan.options.fidelity.persist, n)
             .map_err(|(factors, vertices)| PipelineError::Stage {
                 patch: pid,
-                seed: Some(record.seed),
+                seed: Some(seed),
                 stage: Stage::FidelityFactors,
                 source: StageError::FactorCount { factors, vertices },
             })?;
