@@ -195,3 +195,168 @@ proptest! {
         }
     }
 }
+
+/// Values that break a reader's assumptions, for the structural mutations below.
+const HOSTILE_TOKENS: [&str; 14] = [
+    "nan",
+    "inf",
+    "-inf",
+    "-1",
+    "0",
+    "4294967295",
+    "4294967296",
+    "18446744073709551616",
+    "1e308",
+    "-1e308",
+    "1e-320",
+    "x",
+    "",
+    "3.5",
+];
+
+/// A structural edit of a text file: (line, other line, token index, what).
+type LineEdit = (
+    prop::sample::Index,
+    prop::sample::Index,
+    prop::sample::Index,
+    u8,
+);
+
+/// Apply line-level edits: delete, duplicate or swap lines, or put a hostile token in place
+/// of one of a line's tokens (counts, indices and coordinates alike).
+fn mutate_lines(bytes: &[u8], edits: &[LineEdit]) -> Vec<u8> {
+    let text = String::from_utf8_lossy(bytes);
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    for (at, other, token, what) in edits {
+        if lines.is_empty() {
+            break;
+        }
+        let i = at.index(lines.len());
+        match what % 4 {
+            0 => {
+                lines.remove(i);
+            }
+            1 => {
+                let l = lines[i].clone();
+                lines.insert(i, l);
+            }
+            2 => {
+                let j = other.index(lines.len());
+                lines.swap(i, j);
+            }
+            _ => {
+                let mut toks: Vec<String> =
+                    lines[i].split_whitespace().map(str::to_string).collect();
+                if !toks.is_empty() {
+                    let t = token.index(toks.len());
+                    toks[t] = HOSTILE_TOKENS[other.index(HOSTILE_TOKENS.len())].to_string();
+                }
+                lines[i] = toks.join(" ");
+            }
+        }
+    }
+    let mut out = lines.join("\n").into_bytes();
+    out.push(b'\n');
+    out
+}
+
+/// A `.sol` for [`valid_files`]' mesh (one tensor per vertex), ascii and binary.
+fn valid_sols() -> &'static [Vec<u8>; 2] {
+    static SOLS: std::sync::OnceLock<[Vec<u8>; 2]> = std::sync::OnceLock::new();
+    SOLS.get_or_init(|| {
+        let m = surface(0, 1, 0);
+        let tensors: Vec<_> = (0..m.n_vertices())
+            .map(|i| {
+                nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(4.0 + i as f64, 4.0, 1.0))
+            })
+            .collect();
+        let p = std::path::Path::new("m.sol");
+        [false, true].map(|b| conemesh::io::sol::sol_bytes(p, &tensors, b).expect("sol"))
+    })
+}
+
+/// Algorithm 1 on whatever a mutated file read as: a certified mesh or a typed error, never
+/// a panic. Two patches and no improver keep each case to milliseconds; `--repair` runs
+/// first when the mesh is not an oriented manifold, as a user would try next.
+fn remesh_never_panics(mesh: &TriMesh, metric: Option<&[nalgebra::Matrix3<f64>]>) {
+    use conemesh::pipeline::{RemeshOptions, Remesher, Stages};
+    let options = RemeshOptions {
+        max_patches: Some(2),
+        ..Default::default()
+    };
+    let remesher = Remesher::new(options).with_stages(Stages {
+        improvers: vec![],
+        ..Default::default()
+    });
+    let run = |m: &TriMesh, metric: Option<&[nalgebra::Matrix3<f64>]>| match metric {
+        Some(t) => remesher.run_with_metric(m, t).map(|_| ()),
+        None => remesher.run(m).map(|_| ()),
+    };
+    if run(mesh, metric).is_err() {
+        if let Ok(r) = conemesh::repair::repair(mesh, &Default::default()) {
+            let carried = metric.map(|t| r.vertex_values(t));
+            let _ = run(&r.mesh, carried.as_deref());
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..config() })]
+
+    /// Structural mutations (lines deleted, duplicated, swapped; counts, indices and
+    /// coordinates replaced by hostile values) of every text format, then byte edits of
+    /// every binary one, through the readers and, when they read, through `remesh`.
+    #[test]
+    fn mutated_files_read_or_refuse_and_remesh_or_refuse(
+        which in 0usize..8,
+        line_edits in proptest::collection::vec(
+            (any::<prop::sample::Index>(), any::<prop::sample::Index>(), any::<prop::sample::Index>(), any::<u8>()),
+            1..4),
+        byte_edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 0..3),
+    ) {
+        let (format, bytes) = valid_files()[which].clone();
+        let text = !matches!(which, 4 | 5 | 7); // le.ply, be.ply, b.stl are binary
+        let bytes = if text {
+            mutate_lines(&bytes, &line_edits)
+        } else {
+            let mut b = bytes;
+            for (at, v) in &byte_edits {
+                let i = at.index(b.len());
+                b[i] = *v;
+            }
+            b
+        };
+        match conemesh::io::read_mesh_bytes(&bytes, format, "fuzz") {
+            Err(e) => prop_assert!(e.to_string().starts_with("fuzz"), "{e}"),
+            Ok(loaded) => remesh_never_panics(&loaded.mesh, None),
+        }
+    }
+
+    /// `.sol` files mutated the same way, read for the mesh they belong to and, when they
+    /// read, used as the user metric of a run.
+    #[test]
+    fn mutated_metrics_read_or_refuse_and_remesh_or_refuse(
+        binary in any::<bool>(),
+        line_edits in proptest::collection::vec(
+            (any::<prop::sample::Index>(), any::<prop::sample::Index>(), any::<prop::sample::Index>(), any::<u8>()),
+            1..4),
+        byte_edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..4),
+    ) {
+        let m = surface(0, 1, 0);
+        let sol = &valid_sols()[binary as usize];
+        let bytes = if binary {
+            let mut b = sol.clone();
+            for (at, v) in &byte_edits {
+                let i = at.index(b.len());
+                b[i] = *v;
+            }
+            b
+        } else {
+            mutate_lines(sol, &line_edits)
+        };
+        match conemesh::io::sol::read_sol_bytes(&bytes, "fuzz.sol", m.n_vertices()) {
+            Err(e) => prop_assert!(e.to_string().contains("fuzz.sol"), "{e}"),
+            Ok(tensors) => remesh_never_panics(&m, Some(&tensors)),
+        }
+    }
+}

@@ -4,6 +4,7 @@
 //! # Module map (paper order)
 //! - [`ids`], [`mesh`], [`io`], [`predicates`], [`invariants`], [`check`]: foundation (typed
 //!   ids, the triangle mesh and its topology, file formats, exact predicates, certificates).
+//! - [`repair`]: an almost-manifold input made an oriented manifold, every change listed (ours).
 //! - [`metric`]: Sec. 3.1 / 4.1, the Riemannian metric field (curvature or user `.sol`).
 //! - [`features`]: feature lines kept as patch boundaries (ours).
 //! - [`patches`]: Sec. 3.2, cone patches (Eq. 1-3) and the [`patches::PatchStrategy`] registry.
@@ -40,6 +41,7 @@ pub mod predicates;
 pub mod quality;
 pub mod registry;
 pub mod remesh2d;
+pub mod repair;
 pub mod report;
 pub mod stitch;
 pub mod suite;

@@ -207,9 +207,11 @@ def remesh(V, F, metric=None, **options):
         ``hmax``, ``hgrad`` (``None``), ``keep_boundary=False``,
         ``boundary_corner_angle=45.0``, ``improvers=None`` (``"surface,eq5"``; a list is
         joined), ``no_improve=False``, ``max_patches=None``, ``no_self_intersections=False``,
-        ``quiet=False`` (no progress bar on stderr). Files: ``report``, ``plots``,
-        ``write_metric``, ``debug_dir`` (``None``: an array has no folder to write
-        offending patches into).
+        ``repair=False`` (weld, drop zero-area faces, orient, split non-manifold elements
+        first; the report's ``repair`` lists every change), ``quiet=False`` (no progress
+        bar on stderr). Files: ``report``, ``plots``, ``write_metric``, ``debug_dir``
+        (``None``: an array has no folder to write offending patches into); checked before
+        the run and written together (all or none).
 
     Returns
     -------
@@ -218,8 +220,9 @@ def remesh(V, F, metric=None, **options):
     F : numpy.ndarray of int64, shape (m', 3)
         Its triangles.
     report : dict
-        The JSON report of ``conemesh remesh --report``: ``run`` (options, certificates,
-        per-stage times, warnings), ``eval`` (the yardstick of ``conemesh eval``: Table-1
+        The JSON report of ``conemesh remesh --report``: ``repair`` (with ``repair=True``:
+        welded vertices, dropped/flipped faces, cut edges, split vertices; else ``None``),
+        ``run`` (options, certificates, per-stage times, warnings), ``eval`` (the yardstick of ``conemesh eval``: Table-1
         statistics, distances, flips, topology), ``seconds``, ``peak_rss_mib`` (of this
         process), and ``table_row`` (the Table-1 line).
 

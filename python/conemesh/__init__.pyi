@@ -69,6 +69,7 @@ def remesh(
     improve_rings: int | None = None,
     improve_flips: Literal["energy", "max-min"] | None = None,
     improve_w: float | None = None,
+    repair: bool = False,
     quiet: bool = False,
 ) -> tuple[Vertices, Faces, dict[str, Any]]: ...
 def read(path: PathLike) -> tuple[Vertices, Faces]: ...

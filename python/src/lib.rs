@@ -314,6 +314,20 @@ fn remesh_job(
             "threads={n}: set RAYON_NUM_THREADS before the first remesh instead (the package uses the process's thread pool; the output is the same for every count)"
         )));
     }
+    // The output paths first, as the CLI checks them: a bad path costs no remesh.
+    cli_remesh::check_output_paths(args, false)
+        .map_err(|e| Failure::new("FileError", keywordify(&format!("{e:#}"))))?;
+    let repaired =
+        cli_remesh::repaired_input(args, mesh.clone(), metric.map(<[_]>::to_vec), "the input")
+            .map_err(
+                |e| match e.downcast_ref::<conemesh::repair::RepairError>() {
+                    Some(conemesh::repair::RepairError::Unrepaired(v)) => {
+                        errors::with_invariant(Failure::input(format!("{e:#}")), v)
+                    }
+                    _ => Failure::input(format!("{e:#}")),
+                },
+            )?;
+    let (mesh, metric, repair) = (&repaired.mesh, repaired.metric.as_deref(), &repaired.repair);
     // The pipeline refuses a non-manifold input with a message; certify it here first so
     // that the exception names the elements, in the caller's numbering.
     let topo = conemesh::Topology::build(mesh);
@@ -321,7 +335,9 @@ fn remesh_job(
         .and_then(|()| conemesh::invariants::certify_oriented(mesh, &topo))
         .map_err(|e| {
             errors::with_invariant(
-                Failure::input(format!("the input mesh is not an oriented manifold: {e}")),
+                Failure::input(format!(
+                    "the input mesh is not an oriented manifold: {e} (repair=True orients it and cuts non-manifold edges and vertices)"
+                )),
                 &e,
             )
         })?;
@@ -355,21 +371,6 @@ fn remesh_job(
     // The yardstick of `conemesh remesh`, with its options.
     let eval = cli_remesh::evaluate_output(args, &out)
         .map_err(|e| Failure::new("RemeshError", e.to_string()))?;
-    if let Some(p) = &args.write_metric {
-        conemesh::io::sol::write_sol(p, &out.output_metric(), false)
-            .map_err(|e| errors::from_sol(&e))?;
-    }
-    if let Some(dir) = &args.plots {
-        conemesh::report::write_quality_plots(
-            dir,
-            "remesh",
-            &[
-                ("input", &eval.input_quality),
-                ("output", &eval.output_quality),
-            ],
-        )
-        .map_err(|e| Failure::new("FileError", e.to_string()))?;
-    }
     let r = &out.unit.report;
     // The CLI's `--report` document, with the Table-1 line added.
     let json = serde_json::json!({
@@ -377,6 +378,7 @@ fn remesh_job(
         "output": null,
         "seconds": elapsed,
         "peak_rss_mib": cli_remesh::peak_rss_mib(),
+        "repair": repair,
         "run": r,
         "eval": eval,
         "table_header": conemesh::quality::EvalReport::table_header(),
@@ -384,11 +386,11 @@ fn remesh_job(
     });
     let report =
         serde_json::to_string(&json).map_err(|e| Failure::new("RemeshError", e.to_string()))?;
-    if let Some(p) = &args.report {
-        let pretty = serde_json::to_string_pretty(&json)
-            .map_err(|e| Failure::new("RemeshError", e.to_string()))?;
-        conemesh::io::write_bytes_atomic(p, pretty.as_bytes()).map_err(|e| errors::from_io(&e))?;
-    }
+    // The files asked for, as one transaction (the CLI's `Outputs`): all or none.
+    let mut outputs = conemesh::io::Outputs::new();
+    cli_remesh::stage_side_outputs(&mut outputs, args, &out, &eval, &json, "remesh")
+        .and_then(|()| cli_outputs::commit(outputs))
+        .map_err(|e| Failure::new("FileError", format!("{e:#}")))?;
     Ok(Remeshed {
         mesh: out.mesh,
         report,

@@ -265,3 +265,39 @@ def test_a_flipped_face_names_its_edges_and_an_unused_vertex_is_dropped(bumpy):
     U, G, _ = conemesh.remesh(np.vstack([V, [[5.0, 5.0, 5.0]]]), F, quiet=True)
     U0, G0, _ = conemesh.remesh(V, F, quiet=True)
     assert np.array_equal(U, U0) and np.array_equal(G, G0)
+
+
+def test_repair_orients_the_input_and_lists_every_flip(bumpy):
+    V, F = bumpy
+    flipped = F.copy()
+    flipped[1::4] = flipped[1::4][:, ::-1]
+    U, G, r = conemesh.remesh(V, flipped, repair=True, quiet=True)
+    assert sorted(r["repair"]["flipped_faces"]) == list(range(1, len(F), 4))
+    assert conemesh.check(U, G)["valid"]
+    # Without it, the keyword is named in the refusal.
+    with pytest.raises(conemesh.InputError, match="repair=True"):
+        conemesh.remesh(V, flipped, quiet=True)
+    # On a valid input the repair changes nothing: the same bytes as without it.
+    U1, G1, r1 = conemesh.remesh(V, F, repair=True, quiet=True)
+    U0, G0, r0 = conemesh.remesh(V, F, quiet=True)
+    assert r0["repair"] is None and r1["repair"]["flipped_faces"] == []
+    assert np.array_equal(U0, U1) and np.array_equal(G0, G1)
+
+
+def test_output_paths_are_checked_before_the_run_and_written_together(bumpy, tmp_path):
+    V, F = bumpy
+    t0 = time.monotonic()
+    with pytest.raises(conemesh.FileError, match="does not exist"):
+        conemesh.remesh(V, F, report=tmp_path / "missing" / "r.json", quiet=True)
+    (tmp_path / "plots-file").write_text("a file")
+    with pytest.raises(conemesh.FileError, match="not a folder"):
+        conemesh.remesh(V, F, plots=tmp_path / "plots-file", write_metric=tmp_path / "m.sol", quiet=True)
+    with pytest.raises(conemesh.FileError, match="same path"):
+        conemesh.remesh(V, F, report=tmp_path / "x", write_metric=tmp_path / "x", quiet=True)
+    assert time.monotonic() - t0 < 2.0, "refused before remeshing (a run takes seconds)"
+    assert not (tmp_path / "m.sol").exists() and not (tmp_path / "x").exists()
+    U, G, _ = conemesh.remesh(
+        V, F, report=tmp_path / "r.json", plots=tmp_path / "plots", write_metric=tmp_path / "m.sol", quiet=True
+    )
+    assert (tmp_path / "r.json").is_file() and (tmp_path / "m.sol").is_file()
+    assert any((tmp_path / "plots").glob("*.png"))

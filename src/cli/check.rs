@@ -49,6 +49,16 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         println!("mesh: {name}");
         println!("{report}");
     }
+    let repairable = report.non_manifold_edges
+        + report.non_manifold_vertices
+        + report.inconsistently_oriented_edges
+        + report.degenerate_faces;
+    if repairable > 0 {
+        eprintln!(
+            "hint: `conemesh remesh --repair` orients the surface, cuts non-manifold edges and \
+             vertices, and drops zero-area faces before remeshing (coordinates unchanged)"
+        );
+    }
     Ok(if report.valid {
         ExitCode::SUCCESS
     } else {

@@ -184,6 +184,12 @@ pub struct RemeshArgs {
     /// Algorithm 2: the weight w of Eq. 5 [1] (`eq5.w`).
     #[arg(long)]
     pub improve_w: Option<f64>,
+    /// Repair the input before remeshing: weld vertices at bit-identical positions, drop
+    /// collapsed, zero-area and repeated faces, orient each component consistently, cut
+    /// edges with three or more faces and split vertices with several fans. Coordinates
+    /// are not moved; the report (`repair`) lists every change by element.
+    #[arg(long)]
+    pub repair: bool,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -192,7 +198,7 @@ pub struct RemeshArgs {
 /// Run `conemesh remesh`.
 pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     let t_start = Instant::now();
-    check_output_paths(&args)?;
+    check_output_paths(&args, true)?;
     if let Some(n) = args.threads {
         set_threads(n)?;
     }
@@ -221,6 +227,11 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         ),
         None => None,
     };
+    let RunInput {
+        mesh,
+        metric,
+        repair,
+    } = repaired_input(&args, mesh, metric, &name)?;
     let remesher = Remesher::new(options(&args)).with_stages(stages(&args, metric.is_some())?);
     let bar = progress_bar(args.quiet, mesh.n_faces() as u64);
     let result = remesher.run_with(&mesh, metric.as_deref(), |p: Progress| {
@@ -292,6 +303,67 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             &Default::default(),
         )
         .with_context(|| format!("writing {}", args.output.display()))?;
+    let json = serde_json::json!({
+        "input": name,
+        "output": args.output,
+        "seconds": elapsed,
+        "peak_rss_mib": peak_rss_mib(),
+        "repair": repair,
+        "run": r,
+        "eval": eval,
+    });
+    stage_side_outputs(&mut outputs, &args, &out, &eval, &json, &short_name)?;
+    super::commit(outputs)?;
+    println!("wrote {}", args.output.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The input a run remeshes: the mesh read (repaired with `--repair`), the user's tensors
+/// (carried to the repaired vertices), and the repair's log.
+pub struct RunInput {
+    /// the mesh
+    pub mesh: conemesh::TriMesh,
+    /// one tensor per vertex of `mesh`
+    pub metric: Option<Vec<nalgebra::Matrix3<f64>>>,
+    /// what `--repair` changed; `None` without it
+    pub repair: Option<conemesh::repair::RepairLog>,
+}
+
+/// With `--repair`, the repaired input and the log of changes (one line on stderr);
+/// without, the input as read.
+pub fn repaired_input(
+    args: &RemeshArgs,
+    mesh: conemesh::TriMesh,
+    metric: Option<Vec<nalgebra::Matrix3<f64>>>,
+    name: &str,
+) -> anyhow::Result<RunInput> {
+    if !args.repair {
+        return Ok(RunInput {
+            mesh,
+            metric,
+            repair: None,
+        });
+    }
+    let r = conemesh::repair::repair(&mesh, &Default::default())
+        .with_context(|| format!("repairing {name}"))?;
+    eprintln!("repair: {}", r.log.summary());
+    Ok(RunInput {
+        metric: metric.map(|m| r.vertex_values(&m)),
+        mesh: r.mesh,
+        repair: Some(r.log),
+    })
+}
+
+/// The outputs beside the mesh (`--write-metric`, `--report` with `report` as its document,
+/// `--plots`), staged into `outputs` for the one commit.
+pub fn stage_side_outputs(
+    outputs: &mut conemesh::io::Outputs,
+    args: &RemeshArgs,
+    out: &conemesh::pipeline::Remeshed,
+    eval: &EvalReport,
+    report: &serde_json::Value,
+    short_name: &str,
+) -> anyhow::Result<()> {
     if let Some(p) = &args.write_metric {
         let bytes = conemesh::io::sol::sol_bytes(p, &out.output_metric(), false)?;
         outputs
@@ -299,16 +371,8 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("writing {}", p.display()))?;
     }
     if let Some(p) = &args.report {
-        let json = serde_json::json!({
-            "input": name,
-            "output": args.output,
-            "seconds": elapsed,
-            "peak_rss_mib": peak_rss_mib(),
-            "run": r,
-            "eval": eval,
-        });
         outputs
-            .bytes(p, serde_json::to_string_pretty(&json)?.as_bytes())
+            .bytes(p, serde_json::to_string_pretty(report)?.as_bytes())
             .with_context(|| format!("writing {}", p.display()))?;
     }
     if let Some(dir) = &args.plots {
@@ -317,7 +381,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("writing plots into {}", dir.display()))?;
         conemesh::report::write_quality_plots(
             &staged,
-            &short_name,
+            short_name,
             &[
                 ("input", &eval.input_quality),
                 ("output", &eval.output_quality),
@@ -327,7 +391,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         if let Some(i) = &out.unit.report.improvement {
             conemesh::report::write_improvement_plot(
                 &staged,
-                &short_name,
+                short_name,
                 &i.before.hist_min_angles,
                 &i.after.hist_min_angles,
                 (i.before.theta_min, i.after.theta_min),
@@ -335,17 +399,16 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("writing plots into {}", dir.display()))?;
         }
     }
-    super::commit(outputs)?;
-    println!("wrote {}", args.output.display());
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
 /// Every output path, checked before any work (issue 20): each file's folder exists, no file
-/// output is a directory, `--plots` is not a regular file and its folder exists, and no two outputs (nor an output
-/// and the input or the metric) are the same path.
-fn check_output_paths(args: &RemeshArgs) -> anyhow::Result<()> {
+/// output is a directory, `--plots` is not a regular file and its folder exists, and no two
+/// outputs (nor an output and the input or the metric) are the same path. `mesh_output`:
+/// whether `-o` is one of them (the Python package returns arrays instead).
+pub fn check_output_paths(args: &RemeshArgs, mesh_output: bool) -> anyhow::Result<()> {
     let files: Vec<(&str, &PathBuf)> = [
-        Some(("-o", &args.output)),
+        mesh_output.then_some(("-o", &args.output)),
         args.report.as_ref().map(|p| ("--report", p)),
         args.write_metric.as_ref().map(|p| ("--write-metric", p)),
     ]

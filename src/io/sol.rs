@@ -115,10 +115,20 @@ pub fn read_sol(path: &Path, n_vertices: usize) -> Result<Vec<Matrix3<f64>>, Sol
         path: p.clone(),
         source,
     })?;
+    read_sol_bytes(&bytes, &p, n_vertices)
+}
+
+/// [`read_sol`] on the bytes of a file; `path` only names the source in errors.
+pub fn read_sol_bytes(
+    bytes: &[u8],
+    path: &str,
+    n_vertices: usize,
+) -> Result<Vec<Matrix3<f64>>, SolError> {
+    let p = path.to_string();
     let raw = if bytes.len() >= 4 && (bytes[..4] == [1, 0, 0, 0] || bytes[..4] == [0, 0, 0, 1]) {
-        read_binary(&p, &bytes, n_vertices)?
+        read_binary(&p, bytes, n_vertices)?
     } else {
-        read_ascii(&p, &bytes, n_vertices)?
+        read_ascii(&p, bytes, n_vertices)?
     };
     let per = values_per_vertex(raw.kind);
     let mut out = Vec::with_capacity(raw.count);

@@ -103,7 +103,10 @@ fn certified_input_topology(field: &MetricField) -> Result<Topology, PipelineErr
     crate::invariants::certify_manifold(reference, &topo)
         .and_then(|()| crate::invariants::certify_oriented(reference, &topo))
         .map_err(|e| {
-            PipelineError::Input(format!("the input mesh is not an oriented manifold: {e}"))
+            PipelineError::Input(format!(
+                "the input mesh is not an oriented manifold: {e} (`conemesh remesh --repair`, \
+                 or `repair=True` in Python, orients it and cuts non-manifold edges and vertices)"
+            ))
         })?;
     Ok(topo)
 }

@@ -1,0 +1,220 @@
+//! `conemesh remesh --repair` (issue 20): inputs that are almost oriented manifolds are
+//! refused by name without it (the message names `--repair`), and remeshed with it, the
+//! report listing every change and the output certified.
+
+use conemesh::mesh::generators;
+use conemesh::{Topology, TriMesh, VertexId};
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn conemesh(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_conemesh"))
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8")
+}
+
+/// A small torus with every third face reversed.
+fn shuffled_torus() -> (TriMesh, usize) {
+    let mut m = generators::torus(1.0, 0.4, 16, 8);
+    let mut n = 0;
+    for (f, t) in m.triangles.iter_mut().enumerate() {
+        if f % 3 == 2 {
+            t.swap(0, 1);
+            n += 1;
+        }
+    }
+    (m, n)
+}
+
+fn report(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).expect("report")).expect("json")
+}
+
+#[test]
+fn shuffled_orientation_is_refused_naming_repair_and_oriented_with_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (m, flipped) = shuffled_torus();
+    let input = dir.path().join("shuffled.off");
+    conemesh::io::write_mesh(&input, &m).expect("write");
+    let out = dir.path().join("out.obj");
+    let rep = dir.path().join("report.json");
+
+    let o = conemesh(&["remesh", s(&input), "-o", s(&out), "-q"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("not an oriented manifold"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains("--repair"), "{}", stderr(&o));
+    assert!(!out.exists(), "no output after a refusal");
+
+    let o = conemesh(&[
+        "remesh",
+        s(&input),
+        "-o",
+        s(&out),
+        "--report",
+        s(&rep),
+        "--repair",
+        "--seed",
+        "3",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!("flipped {flipped} faces")),
+        "{}",
+        stderr(&o)
+    );
+    let r = report(&rep);
+    let listed = r["repair"]["flipped_faces"].as_array().expect("list");
+    assert_eq!(listed.len(), flipped);
+    assert_eq!(listed[0], serde_json::json!(2), "input face ids");
+    // The output is a certified torus.
+    let c = conemesh(&["check", s(&out)]);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stdout));
+    let remeshed = conemesh::io::read_mesh(&out).expect("read").mesh;
+    let topo = Topology::build(&remeshed);
+    assert!(topo.is_oriented_manifold());
+    assert_eq!(topo.components()[0].genus, Some(1));
+}
+
+#[test]
+fn two_surfaces_touching_at_a_vertex_are_split_and_remeshed_apart() {
+    // Two tori, the second shifted so that one of its vertices lands exactly on one of the
+    // first's, written as separate vertices: welding makes the shared vertex non-manifold
+    // (two fans), splitting separates it again, and the run remeshes two components.
+    let a = generators::torus(1.0, 0.4, 16, 8);
+    let pa = a.positions[0];
+    let b0 = generators::torus(1.0, 0.4, 16, 8);
+    // Mirror b's copy of vertex 0 onto a's: b is a reflected in the plane x = pa.x, which
+    // maps pa to itself.
+    let mut positions = a.positions.clone();
+    let n = positions.len() as u32;
+    positions.extend(b0.positions.iter().map(|p| {
+        let mut q = *p;
+        q.x = 2.0 * pa.x - q.x;
+        q
+    }));
+    let mut tris = a.triangles.clone();
+    // A reflection reverses orientation: reverse the faces back.
+    tris.extend(b0.triangles.iter().map(|t| {
+        [
+            VertexId(t[0].0 + n),
+            VertexId(t[2].0 + n),
+            VertexId(t[1].0 + n),
+        ]
+    }));
+    let m = TriMesh::new(positions, tris).expect("mesh");
+    assert_eq!(
+        m.positions[n as usize], m.positions[0],
+        "the two tori touch at v0"
+    );
+
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = dir.path().join("touching.obj");
+    conemesh::io::write_mesh(&input, &m).expect("write");
+    let out = dir.path().join("out.obj");
+    let rep = dir.path().join("report.json");
+    let o = conemesh(&[
+        "remesh",
+        s(&input),
+        "-o",
+        s(&out),
+        "--report",
+        s(&rep),
+        "--repair",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = report(&rep);
+    assert_eq!(r["repair"]["welded"].as_array().map(Vec::len), Some(1));
+    let split = r["repair"]["split_vertices"].as_array().expect("list");
+    assert_eq!(split.len(), 1, "{split:?}");
+    assert_eq!(split[0]["vertex"], serde_json::json!(0));
+    let remeshed = conemesh::io::read_mesh(&out).expect("read").mesh;
+    let topo = Topology::build(&remeshed);
+    assert!(topo.is_oriented_manifold());
+    assert_eq!(topo.components().len(), 2);
+    assert!(topo.components().iter().all(|c| c.genus == Some(1)));
+}
+
+#[test]
+fn a_users_metric_follows_the_welded_vertices() {
+    // The torus as a soup (three vertices per face) with a user metric per soup vertex.
+    let m = generators::torus(1.0, 0.4, 12, 6);
+    let mut positions = Vec::new();
+    let mut tris = Vec::new();
+    for f in m.faces() {
+        let b = positions.len() as u32;
+        positions.extend(m.face_points(f));
+        tris.push([VertexId(b), VertexId(b + 1), VertexId(b + 2)]);
+    }
+    let soup = TriMesh::new(positions, tris).expect("soup");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = dir.path().join("soup.obj");
+    conemesh::io::write_mesh(&input, &soup).expect("write");
+    let sol = dir.path().join("soup.sol");
+    let tensor = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(25.0, 4.0, 4.0));
+    conemesh::io::sol::write_sol(&sol, &vec![tensor; soup.n_vertices()], false).expect("sol");
+    let out = dir.path().join("out.obj");
+    let o = conemesh(&[
+        "remesh",
+        s(&input),
+        "--metric",
+        s(&sol),
+        "-o",
+        s(&out),
+        "--repair",
+        "-q",
+    ]);
+    // Without the repair the soup is a valid mesh of single triangles; with it, one torus,
+    // the metric (one tensor per soup vertex) carried to the welded vertices.
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains(&format!(
+        "welded {} vertices",
+        soup.n_vertices() - m.n_vertices()
+    )));
+    let remeshed = conemesh::io::read_mesh(&out).expect("read").mesh;
+    assert_eq!(Topology::build(&remeshed).components()[0].genus, Some(1));
+}
+
+#[test]
+fn a_moebius_band_is_refused_by_name_with_no_output() {
+    let k = 12usize;
+    let mut positions = Vec::new();
+    for i in 0..k {
+        let t = std::f64::consts::TAU * i as f64 / k as f64;
+        let radial = nalgebra::Vector3::new(t.cos(), t.sin(), 0.0);
+        let across = (t / 2.0).cos() * radial + (t / 2.0).sin() * nalgebra::Vector3::z();
+        for w in [-0.3, 0.3] {
+            positions.push(nalgebra::Point3::from(2.0 * radial + w * across));
+        }
+    }
+    let mut tris = Vec::new();
+    for i in 0..k {
+        let (a, b) = (2 * i as u32, 2 * i as u32 + 1);
+        let (c, d) = if i + 1 < k { (a + 2, b + 2) } else { (1, 0) };
+        tris.push([VertexId(a), VertexId(c), VertexId(b)]);
+        tris.push([VertexId(b), VertexId(c), VertexId(d)]);
+    }
+    let m = TriMesh::new(positions, tris).expect("mesh");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = dir.path().join("moebius.ply");
+    conemesh::io::write_mesh(&input, &m).expect("write");
+    let out = dir.path().join("out.obj");
+    let o = conemesh(&["remesh", s(&input), "-o", s(&out), "--repair", "-q"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("not orientable"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("moebius.ply"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
