@@ -171,3 +171,52 @@ fn a_target_too_small_for_the_input_is_refused_up_front() {
     // The ordinary target is accepted.
     assert!(coarse_input_estimate(&f, &RemeshOptions::default()).is_ok());
 }
+
+/// The face budget (issue 20: a CAD part whose creases no feature line follows ran past five
+/// minutes while the fidelity control kept refining): once the working mesh outgrows it, no
+/// patch is refined and no further sweep starts, and the run ends `Ok`, certified, with the
+/// warning naming the budget.
+#[test]
+fn a_run_over_its_face_budget_stops_refining_and_ends_ok_with_a_warning() {
+    use conemesh::pipeline::Warning;
+    let field = unit_field(&generators::torus(1.0, 0.3, 24, 10));
+    let mut options = RemeshOptions {
+        sweeps: 3,
+        coarse_input: CoarseInput::Off,
+        ..RemeshOptions::default()
+    };
+    options.fidelity.max_deviation = 0.0005; // every patch wants its extra rounds
+    let free = remesh(&field, &Stages::default(), &options, |_| {}).expect("runs");
+    assert!(free
+        .report
+        .patch_records
+        .iter()
+        .any(|p| p.fidelity_rounds > 0));
+    assert!(!free
+        .report
+        .warnings
+        .iter()
+        .any(|w| matches!(w, Warning::FaceBudget { .. })));
+
+    options.face_budget = 0.05; // below the input's size: over it after the first batch
+    let bounded = remesh(&field, &Stages::default(), &options, |_| {}).expect("runs");
+    let w = bounded
+        .report
+        .warnings
+        .iter()
+        .find_map(|w| match *w {
+            Warning::FaceBudget {
+                patches, budget, ..
+            } => Some((patches, budget)),
+            _ => None,
+        })
+        .expect("the budget warning");
+    assert_eq!(w.0, 1, "noted after the first patch");
+    assert!(w.1 > 0);
+    let records = &bounded.report.patch_records;
+    assert!(records[1..].iter().all(|p| p.fidelity_rounds == 0));
+    // One sweep only: fewer patches than the run with three.
+    assert!(bounded.report.patches < free.report.patches);
+    assert!(bounded.report.certificate.no_self_intersections == 1);
+    assert!(w.1 < bounded.report.faces_out, "the budget was exceeded");
+}

@@ -174,6 +174,11 @@ pub struct LoopState {
     pub batches: usize,
     /// The patch budget ran out.
     pub budget_exhausted: bool,
+    /// The working mesh outgrew its face budget (times the expected output): the fidelity
+    /// control no longer refines and no further sweep starts.
+    pub over_face_budget: bool,
+    /// (patches, faces) when it did.
+    pub over_face_budget_at: Option<(usize, usize)>,
     /// Times and certificate counts.
     pub counters: Counters,
     /// Per-patch records.
@@ -247,6 +252,8 @@ impl LoopState {
             loop_patches: 0,
             batches: 0,
             budget_exhausted: false,
+            over_face_budget: false,
+            over_face_budget_at: None,
             counters: Counters::default(),
             records: Vec::new(),
             fallbacks: Fallbacks::default(),
@@ -265,7 +272,7 @@ impl LoopState {
     pub fn face_remains(&mut self, ctx: &RunContext<'_>) -> bool {
         let o = &ctx.plan.options;
         if self.work.unprocessed() == 0 {
-            if self.sweep >= o.sweeps {
+            if self.sweep >= o.sweeps || self.over_face_budget {
                 return false;
             }
             // A further sweep (our addition): the new patches' fixed boundaries run through
@@ -279,6 +286,21 @@ impl LoopState {
             return false;
         }
         true
+    }
+
+    /// Note whether the working mesh is over the run's face budget: [`super::RemeshOptions::face_budget`] times the
+    /// larger of the input's face count and the output expected with the a-priori fidelity
+    /// scaling. A run's cost grows with its faces; where the fidelity control keeps
+    /// refining without reaching its tolerance (a crease no feature line follows, cut by
+    /// every chord), this bounds it, and the run ends `Ok` with a warning.
+    pub fn note_face_budget(&mut self, ctx: &RunContext<'_>) {
+        let base = ctx.plan.expected_fidelity.max(self.faces_per_sweep as f64);
+        if !self.over_face_budget
+            && self.work.mesh.n_faces() as f64 > ctx.plan.options.face_budget * base
+        {
+            self.over_face_budget = true;
+            self.over_face_budget_at = Some((self.patches, self.work.mesh.n_faces()));
+        }
     }
 
     /// The unscaled metric (what `eval` measures in) at every working-mesh vertex's reference

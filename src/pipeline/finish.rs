@@ -189,6 +189,15 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
             kept_faces: state.fallbacks.kept_faces,
         });
     }
+    if let Some((patches, faces)) = state.over_face_budget_at {
+        warnings.push(Warning::FaceBudget {
+            patches,
+            faces,
+            budget: (plan.options.face_budget
+                * plan.expected_fidelity.max(state.faces_per_sweep as f64))
+                as usize,
+        });
+    }
     if state.budget_exhausted {
         warnings.push(Warning::PatchBudget {
             patches: state.patches,

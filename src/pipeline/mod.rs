@@ -44,7 +44,7 @@ mod step;
 pub use error::{PipelineError, Stage, StageError};
 pub use options::{
     default_improvers, Cancel, CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO,
-    DEFAULT_BATCH, DEFAULT_IMPROVERS,
+    DEFAULT_BATCH, DEFAULT_IMPROVERS, FACE_BUDGET,
 };
 pub use records::{
     AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,
@@ -84,6 +84,7 @@ pub fn remesh(
         let batch = next_batch(&ctx, &mut state, &mut rng)?; // (a) Sec. 3.2, a vertex apart
         let outcomes = step::batch_steps(&ctx, &state, &batch, &mut rng)?; // (b)-(e), at the same time
         replace::replace_batch(&ctx, &mut state, outcomes)?; // replace each P, update M
+        state.note_face_budget(&ctx); // past it, no more refinement: the run's cost is bounded
         state.batches += 1;
         on_progress(state.progress(&ctx));
         options.cancel.check(state.patches)?;

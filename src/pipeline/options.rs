@@ -80,6 +80,10 @@ pub struct RemeshOptions {
     /// and the seed, never on the thread count. 1 = one patch at a time (the paper). Default
     /// [`DEFAULT_BATCH`].
     pub batch: usize,
+    /// The face budget, a multiple of the larger of the input's face count and the expected
+    /// output (default [`FACE_BUDGET`]); past it the fidelity control stops refining and no
+    /// further sweep starts (a warning, not an error).
+    pub face_budget: f64,
     /// Asks a running job to stop (e.g. Ctrl-C in the Python package); not an option of the
     /// result, so it is not reported. Default: never set.
     #[serde(skip)]
@@ -117,6 +121,14 @@ impl Cancel {
 /// missed the 1 % Hausdorff target on cow, decimated-knight and fertility; BENCHMARKS.md).
 pub const DEFAULT_BATCH: usize = 1;
 
+/// The face budget of a run, as a multiple of the larger of the input's face count and the
+/// output expected with the a-priori fidelity scaling ([`super::Plan::expected_fidelity`]).
+/// Past it the fidelity control stops refining and no further sweep starts
+/// ([`Warning::FaceBudget`](super::Warning::FaceBudget)). The shared meshes stay below
+/// 1× except decimated-knight under the coarse-input profile (9×); a CAD part whose creases
+/// no feature line follows reached 13× after 20 of its patches and ran past 5 minutes.
+pub const FACE_BUDGET: f64 = 12.0;
+
 /// [`CoarseInput::Auto`] runs the coarse-input profile when the a-priori fidelity scaling
 /// multiplies the expected output face count ([`super::expected_faces`]) by at least this much.
 pub const COARSE_RATIO: f64 = 2.0;
@@ -153,6 +165,7 @@ impl Default for RemeshOptions {
             boundary: BoundaryOptions::default(),
             sizes: SizeOptions::default(),
             batch: DEFAULT_BATCH,
+            face_budget: FACE_BUDGET,
             cancel: Cancel::default(),
         }
     }
@@ -179,6 +192,12 @@ impl RemeshOptions {
     pub fn validate(&self) -> Result<(), String> {
         if self.batch == 0 {
             return Err("the patch batch must hold at least 1 patch".to_string());
+        }
+        if !(self.face_budget > 0.0) {
+            return Err(format!(
+                "face budget {} is not a number > 0",
+                self.face_budget
+            ));
         }
         let eps = self.fidelity.max_deviation;
         if !(eps.is_finite() && eps >= 0.0) {

@@ -233,6 +233,17 @@ pub enum Warning {
         /// patches it made
         patches: usize,
     },
+    /// The working mesh outgrew the face budget ([`super::FACE_BUDGET`]): from then on the
+    /// fidelity control did not refine and no further sweep started, so the distance to the
+    /// input may exceed the tolerance.
+    FaceBudget {
+        /// patches made when it happened
+        patches: usize,
+        /// faces of the working mesh then
+        faces: usize,
+        /// the budget
+        budget: usize,
+    },
     /// The coarse-input profile ran ([`RemeshOptions::coarse_profile`]).
     CoarseProfile {
         /// `--coarse on` forced it (else the automatic rule chose it)
@@ -255,6 +266,17 @@ impl fmt::Display for Warning {
                 "{attempts} patch attempt(s) failed their certificates and were retried smaller; \
                  {kept_faces} face(s) (of the input, or of an earlier sweep) could not be remeshed \
                  and were kept as they were (details: --report, `fallbacks`)"
+            ),
+            Warning::FaceBudget {
+                patches,
+                faces,
+                budget,
+            } => write!(
+                f,
+                "the run outgrew its face budget ({faces} faces after {patches} patches, budget \
+                 {budget}): the fidelity control stopped refining and no further sweep ran, so \
+                 the distance to the input may exceed --hausd (sharp creases? try \
+                 --feature-angle)"
             ),
             Warning::PatchBudget {
                 patches,

@@ -155,6 +155,7 @@ pub fn patch_step(
             work: &state.work,
             topo: &state.topo,
             factors: &state.factors,
+            refine: !state.over_face_budget,
         };
         match attempt(ctx, &view, &faces, rng, &mut log.counters) {
             Ok((refined, distortion)) => {
@@ -251,6 +252,8 @@ struct PatchView<'a> {
     work: &'a WorkingMesh,
     topo: &'a Topology,
     factors: &'a VertexFactors,
+    /// The fidelity control may refine (false once the run is over its face budget).
+    refine: bool,
 }
 
 /// A recoverable failure of one attempt: the stage, its error, and the lifted candidate when
@@ -371,7 +374,7 @@ fn attempt(
 
     // (d) planar remeshing with the patch boundary fixed, certified, and (e) mapping back,
     // repeated by the fidelity control while the lifted patch deviates from the reference.
-    let refined = remesh_and_lift(ctx, &disk, &transfer, &domain, view.factors, rng, counters)?;
+    let refined = remesh_and_lift(ctx, view, &disk, &transfer, &domain, rng, counters)?;
 
     // The candidate's new faces, certified before the working mesh is touched.
     let t0 = Instant::now();
@@ -466,16 +469,23 @@ impl Transferred {
 /// mesh, projected onto the reference.
 fn remesh_and_lift(
     ctx: &RunContext<'_>,
+    view: &PatchView<'_>,
     disk: &PatchMesh,
     transfer: &Transferred,
     domain: &PatchDomain,
-    carried: &VertexFactors,
     rng: &mut crate::Rng,
     counters: &mut Counters,
 ) -> Result<Refined, AttemptFailure> {
     let field = ctx.field();
+    let carried = view.factors;
+    // Over the face budget the patch is remeshed once, in the metric it starts from (the
+    // factors carried so far still apply): the run's size stops growing.
+    let mut fidelity = ctx.plan.options.fidelity;
+    if !view.refine {
+        fidelity.rounds = 0;
+    }
     let setup = RoundsSetup {
-        options: &ctx.plan.options.fidelity,
+        options: &fidelity,
         field,
         normals: &ctx.ref_normals,
         l_tar: ctx.plan.l_tar,
