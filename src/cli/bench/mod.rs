@@ -10,6 +10,7 @@
 //! MMG side by side ([`analytic`]).
 
 mod analytic;
+mod tools;
 
 use anyhow::{bail, Context};
 use std::fmt::Write as _;
