@@ -208,7 +208,7 @@ def remesh(V, F, metric=None, **options):
         ``boundary_corner_angle=45.0``, ``improvers=None`` (``"surface,eq5"``; a list is
         joined), ``no_improve=False``, ``max_patches=None``, ``no_self_intersections=False``,
         ``quiet=False`` (no progress bar on stderr). Files: ``report``, ``plots``,
-        ``write_metric``, ``debug_dir`` (``None``: an array has no folder to write
+        ``write_metric``, ``write_input_metric``, ``debug_dir`` (``None``: an array has no folder to write
         offending patches into).
 
     Returns

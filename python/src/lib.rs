@@ -359,6 +359,10 @@ fn remesh_job(
         conemesh::io::sol::write_sol(p, &out.output_metric(), false)
             .map_err(|e| errors::from_sol(&e))?;
     }
+    if let Some(p) = &args.write_input_metric {
+        conemesh::io::sol::write_sol(p, &out.input_metric_unit_target(), false)
+            .map_err(|e| errors::from_sol(&e))?;
+    }
     if let Some(dir) = &args.plots {
         conemesh::report::write_quality_plots(
             dir,
