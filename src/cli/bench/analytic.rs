@@ -9,8 +9,8 @@
 //! the exit code is then 1. Without MMG its rows say "not installed" (not a failure).
 
 use super::tools::{
-    find_mmg, load_average, mmg_version, own_seconds, run_and_score, Eval, Outcome, MMG_ENV,
-    MMG_NAME, MMG_PROTOCOL,
+    self, find_mmg, load_average, mmg_version, own_seconds, run_and_score, Eval, Outcome, ToolRun,
+    MMG_ENV, MMG_NAME, MMG_PROTOCOL,
 };
 use super::{cell, refuse_own_args, remove_stale, BenchArgs, OWN_ARGS};
 use anyhow::{ensure, Context};
@@ -89,12 +89,6 @@ struct Header {
     load_end: Option<String>,
 }
 
-/// One tool's row.
-struct ToolRun {
-    tool: &'static str,
-    outcome: Outcome,
-}
-
 /// One case's two rows.
 struct CaseRow {
     case: &'static Case,
@@ -106,12 +100,7 @@ struct CaseRow {
 impl CaseRow {
     /// conemesh's wall time over MMG's, when both ran.
     fn time_ratio(&self) -> Option<f64> {
-        match (&self.conemesh.outcome, &self.mmg.outcome) {
-            (Outcome::Done { wall: c, .. }, Outcome::Done { wall: m, .. }) if *m > 0.0 => {
-                Some(c / m)
-            }
-            _ => None,
-        }
+        tools::time_ratio(&self.conemesh.outcome, &self.mmg.outcome)
     }
 }
 
@@ -223,49 +212,7 @@ impl Runner {
 
 /// One Markdown row.
 fn tool_row(row: &CaseRow, t: &ToolRun) -> String {
-    let name = cell(row.case.name);
-    let ratio = match (t.tool, row.time_ratio()) {
-        ("conemesh", Some(r)) => format!("{r:.2}"),
-        _ => "-".to_string(),
-    };
-    match &t.outcome {
-        Outcome::NotInstalled => format!(
-            "| {name} | {} | not installed | - | - | - | - | - | - | - | - | - | - |",
-            t.tool
-        ),
-        Outcome::Failed { error, wall } => format!(
-            "| {name} | {} | FAILED: {} | - | - | - | - | - | - | - | {} | - | - |",
-            t.tool,
-            cell(error),
-            wall.map_or("-".to_string(), |w| format!("{w:.2}"))
-        ),
-        Outcome::Done {
-            wall,
-            own,
-            score: s,
-        } => {
-            let valid = match (s.self_intersections, s.topology_kept) {
-                (0, true) => "yes".to_string(),
-                (0, false) => "topology changed".to_string(),
-                (n, true) => format!("{n} self-int"),
-                (n, false) => format!("{n} self-int, topology changed"),
-            };
-            format!(
-                "| {name} | {} | {} | {:.3} / {:.3} | {:.2} / {:.2} | {:.1} | {:.2} | {:.3} | {} | {valid} | {wall:.2} | {} | {ratio} |",
-                t.tool,
-                s.faces,
-                s.q_min,
-                s.q_avg,
-                s.theta_min,
-                s.theta_avg,
-                100.0 * s.in_range,
-                s.mean_ratio,
-                100.0 * s.hausdorff_rel,
-                s.flips,
-                own.map_or("-".to_string(), |o| format!("{o:.2}"))
-            )
-        }
-    }
+    tools::tool_row(row.case.name, t, row.time_ratio())
 }
 
 /// `analytic.md`: the commands, the machine's load, the cases, the results.
@@ -330,11 +277,7 @@ fn table(rows: &[CaseRow], runner: &Runner, header: &Header) -> String {
         );
     }
     let _ = writeln!(s, "\n## Results\n");
-    let _ = writeln!(
-        s,
-        "| case | tool | faces | q_min / q_avg | θ_min / θ_avg (°) | in range % | mean L/L_tar | Hausdorff % | flips | valid | wall s | remesh s | conemesh/MMG |"
-    );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "{}", tools::results_header("case"));
     for r in rows {
         for t in [&r.conemesh, &r.mmg] {
             let _ = writeln!(s, "{}", tool_row(r, t));

@@ -2,7 +2,7 @@
 //! with `--mmg`): finding MMG and its version, running a child with a timeout and timing it,
 //! and scoring an output by `conemesh eval`, so that every tool is measured by one yardstick.
 
-use super::error_line;
+use super::{cell, error_line};
 use anyhow::ensure;
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -207,6 +207,76 @@ pub(super) enum Outcome {
         own: Option<f64>,
         score: Score,
     },
+}
+
+/// One tool's run on one input.
+pub(super) struct ToolRun {
+    pub tool: &'static str,
+    pub outcome: Outcome,
+}
+
+/// conemesh's wall time over MMG's, when both ran.
+pub(super) fn time_ratio(conemesh: &Outcome, mmg: &Outcome) -> Option<f64> {
+    match (conemesh, mmg) {
+        (Outcome::Done { wall: c, .. }, Outcome::Done { wall: m, .. }) if *m > 0.0 => Some(c / m),
+        _ => None,
+    }
+}
+
+/// The header and separator of the results table whose first column is `first`.
+pub(super) fn results_header(first: &str) -> String {
+    format!(
+        "| {first} | tool | faces | q_min / q_avg | θ_min / θ_avg (°) | in range % | mean L/L_tar | Hausdorff % | flips | valid | wall s | remesh s | conemesh/MMG |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    )
+}
+
+/// One tool's Markdown row under [`results_header`] (`ratio`: [`time_ratio`], shown on the
+/// conemesh row).
+pub(super) fn tool_row(name: &str, t: &ToolRun, ratio: Option<f64>) -> String {
+    let name = cell(name);
+    let ratio = match (t.tool, ratio) {
+        ("conemesh", Some(r)) => format!("{r:.2}"),
+        _ => "-".to_string(),
+    };
+    match &t.outcome {
+        Outcome::NotInstalled => format!(
+            "| {name} | {} | not installed | - | - | - | - | - | - | - | - | - | - |",
+            t.tool
+        ),
+        Outcome::Failed { error, wall } => format!(
+            "| {name} | {} | FAILED: {} | - | - | - | - | - | - | - | {} | - | - |",
+            t.tool,
+            cell(error),
+            wall.map_or("-".to_string(), |w| format!("{w:.2}"))
+        ),
+        Outcome::Done {
+            wall,
+            own,
+            score: s,
+        } => {
+            let valid = match (s.self_intersections, s.topology_kept) {
+                (0, true) => "yes".to_string(),
+                (0, false) => "topology changed".to_string(),
+                (n, true) => format!("{n} self-int"),
+                (n, false) => format!("{n} self-int, topology changed"),
+            };
+            format!(
+                "| {name} | {} | {} | {:.3} / {:.3} | {:.2} / {:.2} | {:.1} | {:.2} | {:.3} | {} | {valid} | {wall:.2} | {} | {ratio} |",
+                t.tool,
+                s.faces,
+                s.q_min,
+                s.q_avg,
+                s.theta_min,
+                s.theta_avg,
+                100.0 * s.in_range,
+                s.mean_ratio,
+                100.0 * s.hausdorff_rel,
+                s.flips,
+                own.map_or("-".to_string(), |o| format!("{o:.2}"))
+            )
+        }
+    }
 }
 
 /// Run one tool that writes `output`, then score that output with `score`; the tool's and the
