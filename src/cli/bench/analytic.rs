@@ -9,11 +9,11 @@
 //! the exit code is then 1. Without MMG its rows say "not installed" (not a failure).
 
 use super::tools::{
-    self, find_mmg, load_average, mmg_version, own_seconds, run_and_score, Eval, Outcome, ToolRun,
-    MMG_ENV, MMG_NAME, MMG_PROTOCOL,
+    self, find_mmg, own_seconds, run_and_score, Eval, Header, Outcome, ToolRun, MMG_ENV, MMG_NAME,
+    MMG_PROTOCOL,
 };
 use super::{cell, refuse_own_args, remove_stale, BenchArgs, OWN_ARGS};
-use anyhow::{ensure, Context};
+use anyhow::Context;
 use conemesh::suite::{self, Case, CaseFiles};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -28,11 +28,7 @@ pub(super) fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
     let mut own: Vec<&str> = OWN_ARGS.to_vec();
     own.extend(["--metric", "--ltar", "--ltar-factor"]);
     refuse_own_args(&args.remesh_args, &own)?;
-    ensure!(
-        args.timeout > 0.0 && args.timeout.is_finite(),
-        "--timeout must be a positive number of seconds, got {}",
-        args.timeout
-    );
+    let timeout = super::timeout(args.timeout)?;
     let cases = suite::select(suite::ANALYTIC, &args.cases)?;
     let mmg = find_mmg(args.mmg.as_deref())?;
     std::fs::create_dir_all(&args.out_dir)
@@ -42,16 +38,9 @@ pub(super) fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         out_dir: args.out_dir.clone(),
         mmg,
         remesh_args: args.remesh_args.clone(),
-        timeout: Duration::from_secs_f64(args.timeout),
+        timeout,
     };
-    let header = Header {
-        mmg_version: runner
-            .mmg
-            .as_deref()
-            .map(|p| mmg_version(p, runner.timeout)),
-        load_start: load_average(),
-        load_end: None,
-    };
+    let header = Header::start(runner.mmg.as_deref(), runner.timeout);
     let mut rows = Vec::new();
     for case in cases {
         let row = runner.run_case(case)?;
@@ -60,10 +49,7 @@ pub(super) fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         }
         rows.push(row);
     }
-    let header = Header {
-        load_end: load_average(),
-        ..header
-    };
+    let header = header.end();
     let table = table(&rows, &runner, &header);
     print!("{table}");
     let path = args.out_dir.join("analytic.md");
@@ -80,13 +66,6 @@ pub(super) fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// What the table's preamble says about the run.
-struct Header {
-    mmg_version: Option<String>,
-    load_start: Option<String>,
-    load_end: Option<String>,
 }
 
 /// One case's two rows.

@@ -72,6 +72,32 @@ pub(super) fn load_average() -> Option<String> {
     Some(s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
 }
 
+/// What a table's preamble says about the run: MMG's version, the machine's load.
+pub(super) struct Header {
+    pub mmg_version: Option<String>,
+    pub load_start: Option<String>,
+    pub load_end: Option<String>,
+}
+
+impl Header {
+    /// Before the first run.
+    pub fn start(mmg: Option<&Path>, timeout: Duration) -> Header {
+        Header {
+            mmg_version: mmg.map(|p| mmg_version(p, timeout)),
+            load_start: load_average(),
+            load_end: None,
+        }
+    }
+
+    /// After the last run.
+    pub fn end(self) -> Header {
+        Header {
+            load_end: load_average(),
+            ..self
+        }
+    }
+}
+
 /// A finished child process.
 pub(super) struct Finished {
     pub status: ExitStatus,
@@ -213,6 +239,19 @@ pub(super) enum Outcome {
 pub(super) struct ToolRun {
     pub tool: &'static str,
     pub outcome: Outcome,
+}
+
+/// conemesh and MMG on one input.
+pub(super) struct Pair {
+    pub conemesh: ToolRun,
+    pub mmg: ToolRun,
+}
+
+impl Pair {
+    /// conemesh's wall time over MMG's, when both ran.
+    pub fn time_ratio(&self) -> Option<f64> {
+        time_ratio(&self.conemesh.outcome, &self.mmg.outcome)
+    }
 }
 
 /// conemesh's wall time over MMG's, when both ran.
