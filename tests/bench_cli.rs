@@ -1,16 +1,37 @@
 //! `conemesh bench` (the end-to-end benchmark of issue 9's table): one row per mesh with the
 //! numbers of the run's own report, a failing mesh reported by name without stopping the
 //! others, a non-zero exit when any run failed, and an error when there is nothing to run.
+//! With MMG (a FAKE one here) each mesh also runs through MMG on the run's input metric, both
+//! outputs scored by `conemesh eval`; `--threads` tables several thread counts.
 
 use conemesh::mesh::generators;
+use std::path::Path;
 use std::process::Command;
 
+/// `conemesh bench ARGS` with no MMG to be found (PATH empty, CONEMESH_MMG unset; bench starts
+/// its conemesh children through its own path, not PATH).
 fn bench(args: &[&str]) -> std::process::Output {
+    let empty = tempfile::tempdir().expect("tempdir");
     Command::new(env!("CARGO_BIN_EXE_conemesh"))
         .arg("bench")
         .args(args)
+        .env("PATH", empty.path())
+        .env_remove("CONEMESH_MMG")
         .output()
         .expect("run conemesh bench")
+}
+
+/// The lines of the first table (conemesh's), before the side-by-side section.
+fn first_table(table: &str) -> &str {
+    table.split("\n## ").next().expect("a table")
+}
+
+/// The cells of the side-by-side row of `name` and `tool`.
+fn tool_row(table: &str, name: &str, tool: &str) -> Vec<String> {
+    row(table, &format!("{name} | {tool}"))
+        .into_iter()
+        .skip(1)
+        .collect()
 }
 
 /// The cells of the table row whose first cell is `name`.
@@ -54,7 +75,7 @@ fn bench_tables_every_mesh_of_a_folder_and_names_the_failing_one() {
     let table = std::fs::read_to_string(out.join("remesh.md")).expect("table written");
     assert!(table.contains("`conemesh remesh MESH --seed 3`"), "{table}");
     assert_eq!(
-        table
+        first_table(&table)
             .lines()
             .filter(|l| l.starts_with("| ") && !l.starts_with("| mesh"))
             .count(),
@@ -85,6 +106,20 @@ fn bench_tables_every_mesh_of_a_folder_and_names_the_failing_one() {
     let peak: f64 = t[10].parse().expect("peak MB is measured on Linux");
     assert!(peak > 1.0 && peak < 4096.0, "peak {peak} MB");
     assert!(out.join("torus.obj").is_file());
+    // Without MMG its row says so (not a failure); conemesh's output is scored by eval.
+    let m = tool_row(&table, "torus", "MMG");
+    assert_eq!(m[1], "not installed", "{m:?}");
+    let c = tool_row(&table, "torus", "conemesh");
+    assert_eq!(c[1], t[2], "eval counts the faces of the written output");
+    assert!(
+        c[2].ends_with(&format!("{q_avg:.3}")),
+        "the same yardstick: {}",
+        c[2]
+    );
+    assert!(
+        !out.join("torus-input.sol").exists(),
+        "no metric without MMG"
+    );
 
     let b = row(&table, "broken");
     let status = b.last().expect("cells");
@@ -188,4 +223,157 @@ fn a_stale_report_is_not_read_as_a_failed_runs() {
         !out.join("broken.json").exists(),
         "the stale report is removed"
     );
+}
+
+/// A FAKE `mmgs_O3` (a shell script, for tests only): it remeshes nothing, it copies the `-in`
+/// mesh to `-out` and records its arguments in `OUT.args`, so the MMG row must show the
+/// input's own faces.
+fn fake_mmg(dir: &Path) -> std::path::PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let path = dir.join("fake-mmgs_O3");
+    let script = "#!/bin/sh\n# FAKE mmgs_O3 for conemesh's tests: not MMG, it only copies -in to -out.\n\
+         PATH=/usr/bin:/bin; args=\"$*\"\n\
+         if [ \"$1\" = \"-h\" ]; then echo '  -- FAKE MMGS, Release 0.0 (test stub)'; exit 0; fi\n\
+         while [ $# -gt 0 ]; do case \"$1\" in -in) in=\"$2\"; shift;; -out) out=\"$2\"; shift;; esac; shift; done\n\
+         cp \"$in\" \"$out\" && echo \"$args\" > \"$out.args\"\n";
+    std::fs::write(&path, script).expect("write fake");
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+    path
+}
+
+/// With (a fake) MMG: the run writes the input metric (one tensor per input vertex), MMG gets
+/// the input as `.mesh` with that metric and the issue's protocol, its output is scored by
+/// `conemesh eval` at conemesh's L_tar, and the table has both rows and the time ratio.
+#[test]
+fn with_mmg_the_folder_bench_scores_both_tools_and_gives_the_time_ratio() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let torus = generators::torus(1.0, 0.35, 24, 10);
+    let input = dir.path().join("torus.off");
+    conemesh::io::write_mesh(&input, &torus).expect("write");
+    let mmg = fake_mmg(dir.path());
+    let out = dir.path().join("out");
+    let o = bench(&[
+        input.to_str().expect("utf-8"),
+        "--mmg",
+        mmg.to_str().expect("utf-8"),
+        "-o",
+        out.to_str().expect("utf-8"),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    let table = std::fs::read_to_string(out.join("remesh.md")).expect("table");
+    assert!(
+        table.contains("FAKE MMGS, Release 0.0"),
+        "the version: {table}"
+    );
+
+    // The metric of the run, one tensor per input vertex, went to MMG with the protocol.
+    let sol = out.join("torus-input.sol");
+    let metric = conemesh::io::sol::read_sol(&sol, torus.n_vertices()).expect("input metric");
+    assert!(
+        metric.iter().all(|m| m.symmetric_eigenvalues().min() > 0.0),
+        "SPD"
+    );
+    let args = std::fs::read_to_string(out.join("torus-mmg.mesh.args")).expect("fake ran");
+    assert!(
+        args.contains(&format!("-in {}", out.join("torus.mesh").display()))
+            && args.contains(&format!("-sol {}", sol.display()))
+            && args.contains("-nr -hausd 10 -hgrad -1 -v -1"),
+        "{args}"
+    );
+
+    // MMG's output (the input itself, copied) scored by eval at the run's L_tar.
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("torus.json")).expect("report"))
+            .expect("json");
+    let eval: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("torus-mmg-eval.json")).expect("MMG scored"),
+    )
+    .expect("json");
+    assert_eq!(eval["report"]["output"]["faces"], torus.n_faces());
+    let l_tar = |v: &serde_json::Value| v.as_f64().expect("l_tar");
+    assert_eq!(
+        l_tar(&eval["report"]["l_tar"]),
+        l_tar(&report["run"]["l_tar"]),
+        "one L_tar for both tools"
+    );
+    let m = tool_row(&table, "torus", "MMG");
+    assert_eq!(m[1], torus.n_faces().to_string(), "{m:?}");
+    let q = eval["report"]["output_quality"]["q_avg"]
+        .as_f64()
+        .expect("q");
+    assert!(m[2].ends_with(&format!("{q:.3}")), "{m:?}");
+    let c = tool_row(&table, "torus", "conemesh");
+    assert_eq!(c[1], report["run"]["faces_out"].to_string(), "{c:?}");
+    let ratio: f64 = c.last().expect("cells").parse().expect("a time ratio");
+    let (wall_c, wall_m): (f64, f64) = (c[9].parse().expect("wall"), m[9].parse().expect("wall"));
+    assert!(ratio > 0.0 && wall_c > 0.0 && wall_m >= 0.0, "{c:?} {m:?}");
+    assert_eq!(
+        m.last().map(String::as_str),
+        Some("-"),
+        "the ratio is on conemesh's row"
+    );
+}
+
+/// `--threads 1,2`: both counts run, their times and the speed-up are tabled, and the output
+/// is the same (it does not depend on the thread count), here with batches of 4 patches.
+#[test]
+fn threads_tables_each_count_and_the_outputs_are_the_same() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let input = dir.path().join("torus.off");
+    conemesh::io::write_mesh(&input, &generators::torus(1.0, 0.35, 24, 10)).expect("write");
+    let out = dir.path().join("out");
+    let o = bench(&[
+        input.to_str().expect("utf-8"),
+        "--threads",
+        "1,2",
+        "-o",
+        out.to_str().expect("utf-8"),
+        "--",
+        "--batch",
+        "4",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let table = std::fs::read_to_string(out.join("remesh.md")).expect("table");
+    let section = table
+        .split("## Thread counts")
+        .nth(1)
+        .expect("threads section");
+    assert!(section.contains("| mesh | s at 1 | s at 2 | speed-up 1→2 | same output at 2 |"));
+    let cells = row(section, "torus");
+    let (t1, t2): (f64, f64) = (cells[1].parse().expect("s"), cells[2].parse().expect("s"));
+    let speedup: f64 = cells[3].parse().expect("speed-up");
+    // The cells are rounded to 0.01: the speed-up is the ratio of the times within that.
+    let (lo, hi) = ((t1 - 0.005) / (t2 + 0.005), (t1 + 0.005) / (t2 - 0.005));
+    assert!(
+        t2 > 0.005 && (lo - 0.005..=hi + 0.005).contains(&speedup),
+        "{t1} / {t2} vs {speedup}"
+    );
+    assert_eq!(
+        cells[4], "yes",
+        "the output at 2 threads is the output at 1"
+    );
+    let report = |p: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(out.join(p)).expect("report")).expect("json")
+    };
+    assert_eq!(report("torus.json")["run"]["options"]["batch"], 4);
+    assert_eq!(report("torus-t2.json")["run"]["options"]["batch"], 4);
+    // --threads is bench's to set then.
+    let o = bench(&[
+        input.to_str().expect("utf-8"),
+        "--threads",
+        "1,2",
+        "-o",
+        out.to_str().expect("utf-8"),
+        "--",
+        "--threads",
+        "2",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("set by bench"));
 }

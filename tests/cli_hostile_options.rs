@@ -88,7 +88,7 @@ fn output_paths_are_checked_before_any_work() {
         &conemesh(&["remesh", &input, "-o", &missing]),
         "does not exist",
     );
-    for flag in ["--report", "--write-metric"] {
+    for flag in ["--report", "--write-metric", "--write-input-metric"] {
         let o = conemesh(&["remesh", &input, "-o", &out, flag, &missing]);
         refused(&o, flag);
         assert!(!Path::new(&out).exists(), "{flag}: no mesh written");
@@ -153,6 +153,8 @@ fn all_outputs_as_one_transaction_remesh_undoes_the_mesh_when_the_last_plot_fail
         &s("report.json"),
         "--write-metric",
         &s("out.sol"),
+        "--write-input-metric",
+        &s("in.sol"),
         "--plots",
         &s("plots"),
         "--quiet",
@@ -166,7 +168,7 @@ fn all_outputs_as_one_transaction_remesh_undoes_the_mesh_when_the_last_plot_fail
     assert_eq!(std::fs::read(d("out.obj")).unwrap(), b"old mesh");
     assert_eq!(std::fs::read(d("report.json")).unwrap(), b"old report");
     assert_eq!(std::fs::read(d("plots/hist_q.png")).unwrap(), b"old plot");
-    assert!(!d("out.sol").exists());
+    assert!(!d("out.sol").exists() && !d("in.sol").exists());
     assert!(!d("plots/hist_angles.png").exists());
     assert!(d("plots/hist_min_angles.png").is_dir());
     assert_eq!(temporaries(dir.path()), Vec::<String>::new());
@@ -181,6 +183,8 @@ fn all_outputs_as_one_transaction_remesh_undoes_the_mesh_when_the_last_plot_fail
         &s("report.json"),
         "--write-metric",
         &s("out.sol"),
+        "--write-input-metric",
+        &s("in.sol"),
         "--plots",
         &s("plots"),
         "--quiet",
@@ -190,7 +194,8 @@ fn all_outputs_as_one_transaction_remesh_undoes_the_mesh_when_the_last_plot_fail
     let mesh = conemesh::io::read_mesh(&d("out.obj")).expect("new mesh");
     assert!(mesh.mesh.n_faces() > 0);
     assert_ne!(std::fs::read(d("report.json")).unwrap(), b"old report");
-    assert!(d("out.sol").is_file() && d("plots/hist_min_angles.png").is_file());
+    assert!(d("out.sol").is_file() && d("in.sol").is_file());
+    assert!(d("plots/hist_min_angles.png").is_file());
     assert_ne!(std::fs::read(d("plots/hist_q.png")).unwrap(), b"old plot");
     assert_eq!(temporaries(dir.path()), Vec::<String>::new());
 }

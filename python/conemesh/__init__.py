@@ -209,9 +209,9 @@ def remesh(V, F, metric=None, **options):
         joined), ``no_improve=False``, ``max_patches=None``, ``no_self_intersections=False``,
         ``repair=False`` (weld, drop zero-area faces, orient, split non-manifold elements
         first; the report's ``repair`` lists every change), ``quiet=False`` (no progress
-        bar on stderr). Files: ``report``, ``plots``, ``write_metric``, ``debug_dir``
-        (``None``: an array has no folder to write offending patches into); checked before
-        the run and written together (all or none).
+        bar on stderr). Files: ``report``, ``plots``, ``write_metric``,
+        ``write_input_metric``, ``debug_dir`` (``None``: an array has no folder to write
+        offending patches into); checked before the run and written together (all or none).
 
     Returns
     -------

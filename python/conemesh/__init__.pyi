@@ -47,6 +47,7 @@ def remesh(
     report: str | os.PathLike[str] | None = None,
     plots: str | os.PathLike[str] | None = None,
     write_metric: str | os.PathLike[str] | None = None,
+    write_input_metric: str | os.PathLike[str] | None = None,
     debug_dir: str | os.PathLike[str] | None = None,
     no_self_intersections: bool = False,
     hausd: float = 0.0035,

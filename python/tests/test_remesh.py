@@ -203,6 +203,33 @@ def test_a_user_metric_runs_and_is_written(bumpy, tmp_path):
     assert 0.5 < e["output_conformity"]["mean"] < 2.0
 
 
+def _read_ascii_sol(path: Path) -> np.ndarray:
+    """The tensors of an ASCII Medit ``.sol`` (``m11 m12 m22 m13 m23 m33`` per vertex)."""
+    words = path.read_text().split()
+    i = words.index("SolAtVertices")
+    n = int(words[i + 1])
+    assert words[i + 2 : i + 4] == ["1", "3"], "one symmetric tensor per vertex"
+    x = np.array(words[i + 4 : i + 4 + 6 * n], dtype=float).reshape(n, 6)
+    m11, m12, m22, m13, m23, m33 = x.T
+    return np.stack(
+        [np.stack([m11, m12, m13], -1), np.stack([m12, m22, m23], -1), np.stack([m13, m23, m33], -1)],
+        -2,
+    )
+
+
+def test_write_input_metric_is_the_users_metric_over_ltar_squared(bumpy, tmp_path):
+    V, F = bumpy
+    h, ltar = 0.1, 2.0
+    M = np.tile(np.eye(3) / h**2, (len(V), 1, 1))
+    path = tmp_path / "in.sol"
+    conemesh.remesh(V, F, M, ltar=ltar, hausd=0.0, quiet=True, write_input_metric=path)
+    W = _read_ascii_sol(path)
+    # One tensor per input vertex; an isotropic metric restricted to the tangent plane and
+    # completed along the normal by its tangent eigenvalue is isotropic again, over L_tar².
+    assert W.shape == (len(V), 3, 3)
+    np.testing.assert_allclose(W, np.tile(np.eye(3) / (h * ltar) ** 2, (len(V), 1, 1)), rtol=1e-9, atol=1e-9)
+
+
 def test_the_gil_is_released(meshes):
     V, F = conemesh.read(meshes / "3holes.off")
     done = threading.Event()

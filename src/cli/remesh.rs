@@ -93,6 +93,13 @@ pub struct RemeshArgs {
     /// was built to, a user's tensors restricted to the surface's tangent plane.
     #[arg(long)]
     pub write_metric: Option<PathBuf>,
+    /// Write the metric the run remeshes to at the input vertices (Medit .sol, file units,
+    /// one tensor per vertex of the input file, of the repaired input with `--repair`): the
+    /// curvature or user metric with the size
+    /// controls and the a-priori fidelity scaling, over L_tar² (MMG's `-ltar 1`: an edge on
+    /// target has length 1) and SPD in 3D, so MMG can be run on the input with it.
+    #[arg(long, value_name = "FILE.sol")]
+    pub write_input_metric: Option<PathBuf>,
     /// Directory for offending patches when a certificate fails (default: the output's).
     #[arg(long)]
     pub debug_dir: Option<PathBuf>,
@@ -370,6 +377,12 @@ pub fn stage_side_outputs(
             .bytes(p, &bytes)
             .with_context(|| format!("writing {}", p.display()))?;
     }
+    if let Some(p) = &args.write_input_metric {
+        let bytes = conemesh::io::sol::sol_bytes(p, &out.input_metric_unit_target(), false)?;
+        outputs
+            .bytes(p, &bytes)
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
     if let Some(p) = &args.report {
         outputs
             .bytes(p, serde_json::to_string_pretty(report)?.as_bytes())
@@ -411,6 +424,9 @@ pub fn check_output_paths(args: &RemeshArgs, mesh_output: bool) -> anyhow::Resul
         mesh_output.then_some(("-o", &args.output)),
         args.report.as_ref().map(|p| ("--report", p)),
         args.write_metric.as_ref().map(|p| ("--write-metric", p)),
+        args.write_input_metric
+            .as_ref()
+            .map(|p| ("--write-input-metric", p)),
     ]
     .into_iter()
     .flatten()

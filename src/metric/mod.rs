@@ -5,6 +5,7 @@
 //! - [`curvature`]: principal curvatures and directions by a local quadric fit.
 //! - [`curvature_metric`]: `M = (d₁,d₂,n) diag(max(|k₁|,10⁻⁴), max(|k₂|,10⁻⁴), 0) (d₁,d₂,n)ᵀ`.
 //! - [`field`]: [`MetricField`], the one way later stages ask for the metric.
+//! - [`unit_target`]: a metric in MMG's `-ltar 1` convention, SPD in 3D, for other remeshers.
 //!
 //! User-supplied metrics come from Medit `.sol` files ([`crate::io::sol`]).
 
@@ -12,11 +13,13 @@ pub mod curvature;
 pub mod field;
 pub mod normalize;
 pub mod sizes;
+pub mod unit_target;
 
 pub use curvature::{principal_curvatures, tangent_frame, CurvatureOptions, PrincipalCurvature};
 pub use field::{validate_vertex_metric, MetricField};
 pub use normalize::Normalization;
 pub use sizes::{apply_sizes, SizeOptions};
+pub use unit_target::unit_target_metric;
 
 use crate::mesh::{MeshError, TriMesh};
 use nalgebra::Matrix3;

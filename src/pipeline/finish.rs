@@ -269,5 +269,6 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
         curve: state.work.curve,
         curves: ctx.curves.clone(),
         report,
+        remesh_metric: ctx.field().vertex_metrics().to_vec(),
     }
 }

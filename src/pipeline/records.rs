@@ -505,6 +505,10 @@ pub struct RemeshResult {
     pub curves: crate::boundary::BoundaryCurves,
     /// What was done and certified.
     pub report: RemeshReport,
+    /// The metric the patches were remeshed in, at every reference vertex (unit space): the
+    /// run's metric (the size controls applied) with the a-priori fidelity factors
+    /// ([`super::Plan::remesh_field`]), before the fidelity control's local refinements.
+    pub remesh_metric: Vec<nalgebra::Matrix3<f64>>,
 }
 
 /// Progress reported after every patch.

@@ -18,7 +18,7 @@ use super::records::{Progress, RemeshResult, Warning};
 use crate::ids::VertexId;
 use crate::invariants;
 use crate::mesh::TriMesh;
-use crate::metric::{MetricError, MetricField, MetricOptions, Normalization};
+use crate::metric::{unit_target_metric, MetricError, MetricField, MetricOptions, Normalization};
 use nalgebra::Matrix3;
 
 /// Algorithm 1 from a mesh in file units: [`Remesher::run`] drops unreferenced vertices,
@@ -43,6 +43,8 @@ pub struct Remeshed {
     pub unit: RemeshResult,
     /// The input after dropping unreferenced vertices (the reference, in file units).
     pub input: TriMesh,
+    /// Where each vertex of the mesh as given went in `input` (`None`: unreferenced, dropped).
+    pub input_vertices: Vec<Option<VertexId>>,
     /// The user metric at the vertices of `input` (file units), when one was given.
     pub input_metric: Option<Vec<Matrix3<f64>>>,
     /// The scaling between file units and unit space.
@@ -60,6 +62,30 @@ impl Remeshed {
             .locations
             .iter()
             .map(|l| self.normalization.metric_from_unit(&self.field.eval_at(l)))
+            .collect()
+    }
+
+    /// The metric the run remeshes to, at every vertex of the mesh as given (unreferenced
+    /// ones too), in file units and scaled so that an edge on target has metric length 1
+    /// (MMG's `-ltar 1`): the curvature or user metric with the size controls and the
+    /// a-priori fidelity factors of the run ([`RemeshResult::remesh_metric`]), over L_tar²,
+    /// completed along the normal to be SPD ([`unit_target_metric`]). What
+    /// `--write-input-metric` writes, so that MMG can be given the same metric as conemesh.
+    ///
+    /// An unreferenced vertex carries no surface; it gets the mean of the other tensors, so
+    /// that the file has an SPD tensor at every vertex of the mesh (MMG reads one per vertex).
+    pub fn input_metric_unit_target(&self) -> Vec<Matrix3<f64>> {
+        let file_units: Vec<Matrix3<f64>> = self
+            .unit
+            .remesh_metric
+            .iter()
+            .map(|m| self.normalization.metric_from_unit(m))
+            .collect();
+        let kept = unit_target_metric(&self.input, &file_units, self.unit.report.l_tar);
+        let mean = kept.iter().sum::<Matrix3<f64>>() / kept.len().max(1) as f64;
+        self.input_vertices
+            .iter()
+            .map(|v| v.map_or(mean, |v| kept[v.idx()]))
             .collect()
     }
 }
@@ -176,6 +202,7 @@ impl Remesher {
             warnings: unit.report.warnings.clone(),
             unit,
             input: file_mesh,
+            input_vertices: map,
             input_metric,
             normalization: norm,
             field,

@@ -6,16 +6,23 @@
 //! Each mesh runs in its own process so that its peak resident memory is its own (the child
 //! reports `VmHWM` in its JSON report) and a failing mesh cannot take the others down.
 //!
+//! With MMG (`--mmg`, else `mmgs_O3` on PATH, else `$CONEMESH_MMG`) every mesh also runs
+//! through MMG on the same input and the metric conemesh's run remeshes to, both outputs scored
+//! by `conemesh eval` ([`side_by_side`]); `--threads 1,2` runs conemesh once per thread count
+//! and tables the times, the speed-up and whether the outputs are the same.
+//!
 //! `conemesh bench --suite analytic` runs the generated analytic suite instead, conemesh and
 //! MMG side by side ([`analytic`]).
 
 mod analytic;
+mod side_by_side;
+mod tools;
 
-use anyhow::{bail, Context};
+use anyhow::{bail, ensure, Context};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
-use std::time::Instant;
+use std::time::Duration;
 
 /// The extensions `conemesh` reads (see `conemesh::io`).
 const MESH_EXTENSIONS: [&str; 5] = ["obj", "off", "ply", "stl", "mesh"];
@@ -37,7 +44,10 @@ pub struct BenchArgs {
     #[arg(long, default_value = "../shared/meshes", conflicts_with = "suite")]
     pub dir: PathBuf,
     /// Folder for the outputs: `remesh.md` (the table), and per mesh `NAME.obj`, `NAME.json`
-    /// (the remesh report) and `NAME.log` (its stdout and stderr). With `--suite`:
+    /// (the remesh report), `NAME.log` (its stdout and stderr), `NAME-eval.json`/`.log` (its
+    /// score); with MMG also `NAME-input.sol` (the metric of the run), `NAME.mesh` (the input
+    /// for MMG), `NAME-mmg.mesh`, `NAME-mmg-eval.json` and `NAME-mmg.log`; with `--threads`
+    /// the further counts' `NAME-tN.obj`/`.json`/`.log`. With `--suite`:
     /// `analytic.md`, and per case its input `NAME.mesh` + `NAME.sol`, then per tool (`conemesh`,
     /// `mmg`) `NAME-TOOL.obj`/`.mesh`, `NAME-TOOL-eval.json` and `NAME-TOOL.log`.
     #[arg(short, long, default_value = "bench")]
@@ -54,14 +64,28 @@ pub struct BenchArgs {
     /// Suite only: run the cases whose name contains SUBSTRING (repeatable; default all).
     #[arg(long = "case", value_name = "SUBSTRING", requires = "suite")]
     pub cases: Vec<String>,
-    /// Suite only: MMG's surface remesher [default: `mmgs_O3` on PATH, else $CONEMESH_MMG;
-    /// without one the MMG rows say "not installed"].
-    #[arg(long, value_name = "PATH", requires = "suite")]
+    /// MMG's surface remesher [default: `mmgs_O3` on PATH, else $CONEMESH_MMG; without one
+    /// the MMG rows say "not installed"]. On a folder: per mesh, after conemesh's run,
+    /// `PATH -in NAME.mesh -sol NAME-input.sol -out NAME-mmg.mesh -nr -hausd 10 -hgrad -1 -v -1`
+    /// with the metric conemesh's run remeshes to (`remesh --write-input-metric`, target
+    /// length 1), both outputs scored by `conemesh eval` at the run's L_tar.
+    #[arg(long, value_name = "PATH")]
     pub mmg: Option<PathBuf>,
-    /// Suite only: wall-clock limit of every child process, seconds (past it the child is
-    /// killed and its row is FAILED).
+    /// Wall-clock limit of every child process, seconds (past it the child is killed and its
+    /// row is FAILED).
     #[arg(long, value_name = "SECONDS", default_value_t = 900.0)]
     pub timeout: f64,
+    /// Folder only: run conemesh once per thread count of the comma-separated list (`remesh
+    /// --threads N`; e.g. `--threads 1,2 -- --batch 8`); the first count's run is the one
+    /// tabled and compared with MMG, and a table gives every count's time, the speed-up over
+    /// the first and whether the output is byte for byte the first's.
+    #[arg(
+        long,
+        value_name = "N,N,...",
+        value_delimiter = ',',
+        conflicts_with = "suite"
+    )]
+    pub threads: Vec<usize>,
 }
 
 /// Remesh arguments bench sets itself for every run: a second value would only make every
@@ -78,6 +102,26 @@ fn refuse_own_args(remesh_args: &[String], own: &[&str]) -> anyhow::Result<()> {
 
 const OWN_ARGS: [&str; 5] = ["-o", "--output", "--report", "-q", "--quiet"];
 
+/// `--timeout` as a duration, refused unless a positive number of seconds.
+fn timeout(seconds: f64) -> anyhow::Result<Duration> {
+    ensure!(
+        seconds > 0.0 && seconds.is_finite(),
+        "--timeout must be a positive number of seconds, got {seconds}"
+    );
+    Ok(Duration::from_secs_f64(seconds))
+}
+
+/// The value of `flag` among the remesh arguments (`--flag V` or `--flag=V`).
+fn remesh_arg_value<'a>(remesh_args: &'a [String], flag: &str) -> Option<&'a str> {
+    remesh_args.iter().enumerate().find_map(|(i, a)| {
+        if a == flag {
+            remesh_args.get(i + 1).map(String::as_str)
+        } else {
+            a.strip_prefix(flag).and_then(|v| v.strip_prefix('='))
+        }
+    })
+}
+
 /// The targets of Algorithm 1 before minimum-angle improvement (issue 9, the paper's Table 1
 /// level), measured by `eval` against the input at the run's L_tar.
 const TARGET_Q_AVG: f64 = 0.85;
@@ -88,7 +132,8 @@ const TARGET_HAUSDORFF_REL: f64 = 0.01;
 struct Row {
     name: String,
     outcome: Result<Numbers, String>,
-    wall: f64,
+    /// The child's wall time, spawn to exit (`None`: it could not start, or timed out).
+    wall: Option<f64>,
 }
 
 struct Numbers {
@@ -103,6 +148,8 @@ struct Numbers {
     flips: usize,
     seconds: f64,
     peak_mb: Option<f64>,
+    /// The run's target metric edge length (what MMG's output is scored at too).
+    l_tar: f64,
 }
 
 impl Numbers {
@@ -156,6 +203,7 @@ impl Numbers {
                 .ok_or("`eval.flips` is not a list")?,
             seconds: f(&["seconds"])?,
             peak_mb: json.get("peak_rss_mib").and_then(|v| v.as_f64()),
+            l_tar: f(&["run", "l_tar"])?,
         })
     }
 }
@@ -173,7 +221,16 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
     if meshes.is_empty() {
         bail!("no mesh files in {}", args.dir.display());
     }
-    refuse_own_args(&args.remesh_args, &OWN_ARGS)?;
+    let mut own: Vec<&str> = OWN_ARGS.to_vec();
+    own.push("--write-input-metric");
+    if !args.threads.is_empty() {
+        own.push("--threads");
+    }
+    refuse_own_args(&args.remesh_args, &own)?;
+    let timeout = timeout(args.timeout)?;
+    if let Some(n) = args.threads.iter().find(|n| **n == 0) {
+        bail!("--threads: every thread count must be at least 1, got {n}");
+    }
     // Outputs are named by the input's file stem: two inputs with one stem would overwrite
     // each other's output, report and log.
     let mut stems: Vec<(String, &PathBuf)> = meshes.iter().map(|m| (stem(m), m)).collect();
@@ -186,8 +243,18 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
             w[0].0
         );
     }
+    let mmg = tools::find_mmg(args.mmg.as_deref())?;
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;
+    let folder = Folder {
+        exe: std::env::current_exe().context("locating the conemesh executable")?,
+        out_dir: args.out_dir.clone(),
+        remesh_args: args.remesh_args.clone(),
+        threads: args.threads.clone(),
+        timeout,
+        mmg,
+        metric: remesh_arg_value(&args.remesh_args, "--metric").map(PathBuf::from),
+    };
     // An output must not replace its input (a mesh benched from inside the output folder).
     let out_dir = args
         .out_dir
@@ -197,77 +264,200 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
         let input = mesh
             .canonicalize()
             .with_context(|| format!("reading {}", mesh.display()))?;
-        if input == out_dir.join(format!("{}.obj", stem(mesh))) {
+        let name = stem(mesh);
+        if folder
+            .outputs(&name, mesh)
+            .iter()
+            .any(|o| input == out_dir.join(o.file_name().unwrap_or_default()))
+        {
             bail!(
                 "{} would be overwritten by its own output; choose another --out-dir",
                 mesh.display()
             );
         }
     }
-    let exe = std::env::current_exe().context("locating the conemesh executable")?;
+    let header = tools::Header::start(folder.mmg.as_deref(), timeout);
     let mut rows = Vec::new();
     for mesh in &meshes {
         let name = stem(mesh);
-        let out = args.out_dir.join(format!("{name}.obj"));
-        let report = args.out_dir.join(format!("{name}.json"));
         // A stale report must not be read as this run's, nor a stale mesh stand beside a
         // failed run.
-        for stale in [&report, &out] {
-            remove_stale(stale)?;
+        for stale in folder.outputs(&name, mesh) {
+            remove_stale(&stale)?;
         }
-        let t0 = Instant::now();
-        let child = Command::new(&exe)
-            .arg("remesh")
-            .arg(mesh)
-            .arg("-o")
-            .arg(&out)
-            .arg("--report")
-            .arg(&report)
-            .arg("--quiet")
-            .args(&args.remesh_args)
-            .output()
-            .with_context(|| format!("running {} remesh", exe.display()))?;
-        let wall = t0.elapsed().as_secs_f64();
-        let mut log = child.stdout.clone();
-        log.extend_from_slice(&child.stderr);
-        let log_path = args.out_dir.join(format!("{name}.log"));
-        conemesh::io::write_bytes_atomic(&log_path, &log)
-            .with_context(|| format!("writing {}", log_path.display()))?;
-        let outcome = if child.status.success() {
-            std::fs::read_to_string(&report)
-                .map_err(|e| format!("reading {}: {e}", report.display()))
-                .and_then(|s| {
-                    serde_json::from_str::<serde_json::Value>(&s)
-                        .map_err(|e| format!("{}: {e}", report.display()))
-                })
-                .and_then(|j| Numbers::from_report(&j))
-        } else {
-            Err(format!(
-                "remesh failed ({}): {}",
-                child.status,
-                error_line(&String::from_utf8_lossy(&child.stderr))
-            ))
-        };
-        let row = Row {
-            name,
-            outcome,
-            wall,
-        };
+        let row = folder.remesh(mesh, &name, "", folder.threads.first().copied())?;
         eprintln!("{}", row_text(&row));
-        rows.push(row);
+        let mut threads = Vec::new();
+        for &n in folder.threads.iter().skip(1) {
+            let other = folder.remesh(mesh, &name, &format!("-t{n}"), Some(n))?;
+            let same = match (&row.outcome, &other.outcome) {
+                (Ok(_), Ok(_)) => Some(same_bytes(
+                    &folder.path(&name, ".obj"),
+                    &folder.path(&name, &format!("-t{n}.obj")),
+                )),
+                _ => None,
+            };
+            threads.push(ThreadRun {
+                outcome: other.outcome.map(|o| o.seconds),
+                same,
+            });
+        }
+        let pair = side_by_side::run_mesh(&folder, mesh, &name, &row)?;
+        for t in [&pair.conemesh, &pair.mmg] {
+            eprintln!("{}", tools::tool_row(&name, t, pair.time_ratio()));
+        }
+        rows.push(MeshRows { row, threads, pair });
     }
-    let table = table(&rows, &args.remesh_args);
+    let header = header.end();
+    let table = table(&rows, &folder, &header);
     print!("{table}");
     let path = args.out_dir.join("remesh.md");
     conemesh::io::write_bytes_atomic(&path, table.as_bytes())
         .with_context(|| format!("writing {}", path.display()))?;
     println!("wrote {}", path.display());
-    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
+    let failed = rows
+        .iter()
+        .filter(|r| {
+            r.row.outcome.is_err()
+                || r.threads
+                    .iter()
+                    .any(|t| t.outcome.is_err() || t.same == Some(false))
+                || [&r.pair.conemesh, &r.pair.mmg]
+                    .iter()
+                    .any(|t| matches!(t.outcome, tools::Outcome::Failed { .. }))
+        })
+        .count();
     if failed > 0 {
-        eprintln!("error: {failed} of {} runs failed", rows.len());
+        eprintln!("error: {failed} of {} meshes had a failed run", rows.len());
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// What every mesh's runs share.
+struct Folder {
+    exe: PathBuf,
+    out_dir: PathBuf,
+    remesh_args: Vec<String>,
+    /// `--threads`: the thread counts, the first for the tabled run (empty: remesh's default).
+    threads: Vec<usize>,
+    timeout: Duration,
+    mmg: Option<PathBuf>,
+    /// The remesh arguments' `--metric`, for scoring MMG's output in the same metric.
+    metric: Option<PathBuf>,
+}
+
+impl Folder {
+    fn path(&self, name: &str, suffix: &str) -> PathBuf {
+        self.out_dir.join(format!("{name}{suffix}"))
+    }
+
+    /// Every file bench writes for the mesh `name` at `input` (the table aside).
+    fn outputs(&self, name: &str, input: &Path) -> Vec<PathBuf> {
+        let mut suffixes: Vec<String> = [".obj", ".json", ".log", "-eval.json", "-eval.log"]
+            .map(String::from)
+            .to_vec();
+        if self.mmg.is_some() {
+            suffixes.extend(
+                [
+                    "-input.sol",
+                    "-mmg.mesh",
+                    "-mmg.sol",
+                    "-mmg-eval.json",
+                    "-mmg.log",
+                ]
+                .map(String::from),
+            );
+            if side_by_side::needs_conversion(input) {
+                suffixes.push(".mesh".into());
+            }
+        }
+        for n in self.threads.iter().skip(1) {
+            suffixes.extend([".obj", ".json", ".log"].map(|s| format!("-t{n}{s}")));
+        }
+        suffixes.iter().map(|s| self.path(name, s)).collect()
+    }
+
+    /// One `conemesh remesh` run of `mesh` writing `NAME{tag}.obj`, `.json` and `.log` (with
+    /// `--threads N` when given; with `--write-input-metric NAME-input.sol` for MMG on the
+    /// tabled run). Only a log the out dir refuses is an error; a failing run is a FAILED row.
+    fn remesh(
+        &self,
+        mesh: &Path,
+        name: &str,
+        tag: &str,
+        threads: Option<usize>,
+    ) -> anyhow::Result<Row> {
+        let out = self.path(name, &format!("{tag}.obj"));
+        let report = self.path(name, &format!("{tag}.json"));
+        let mut cmd = Command::new(&self.exe);
+        cmd.arg("remesh")
+            .arg(mesh)
+            .arg("-o")
+            .arg(&out)
+            .arg("--report")
+            .arg(&report)
+            .arg("--quiet");
+        if let Some(n) = threads {
+            cmd.args(["--threads", &n.to_string()]);
+        }
+        if self.mmg.is_some() && tag.is_empty() {
+            cmd.arg("--write-input-metric")
+                .arg(self.path(name, "-input.sol"));
+        }
+        cmd.args(&self.remesh_args);
+        let (outcome, wall) = match tools::run_timed(&mut cmd, self.timeout) {
+            Err(e) => (Err(format!("remesh {e}")), None),
+            Ok(child) => {
+                let mut log = child.stdout.clone();
+                log.extend_from_slice(&child.stderr);
+                let log_path = self.path(name, &format!("{tag}.log"));
+                conemesh::io::write_bytes_atomic(&log_path, &log)
+                    .with_context(|| format!("writing {}", log_path.display()))?;
+                let outcome = if child.status.success() {
+                    std::fs::read_to_string(&report)
+                        .map_err(|e| format!("reading {}: {e}", report.display()))
+                        .and_then(|s| {
+                            serde_json::from_str::<serde_json::Value>(&s)
+                                .map_err(|e| format!("{}: {e}", report.display()))
+                        })
+                        .and_then(|j| Numbers::from_report(&j))
+                } else {
+                    Err(format!(
+                        "remesh failed ({}): {}",
+                        child.status,
+                        error_line(&String::from_utf8_lossy(&child.stderr))
+                    ))
+                };
+                (outcome, Some(child.wall))
+            }
+        };
+        Ok(Row {
+            name: name.to_string(),
+            outcome,
+            wall,
+        })
+    }
+}
+
+/// The two files have the same bytes (both readable).
+fn same_bytes(a: &Path, b: &Path) -> bool {
+    matches!((std::fs::read(a), std::fs::read(b)), (Ok(x), Ok(y)) if x == y)
+}
+
+/// A further thread count's run of one mesh.
+struct ThreadRun {
+    /// The run's own time (`remesh s`), or why it failed.
+    outcome: Result<f64, String>,
+    /// Its output is byte for byte the tabled run's (`None`: one of them failed).
+    same: Option<bool>,
+}
+
+/// Everything one mesh gave.
+struct MeshRows {
+    row: Row,
+    threads: Vec<ThreadRun>,
+    pair: tools::Pair,
 }
 
 /// Remove a previous run's output, so that it is not read as this run's nor left beside a
@@ -331,7 +521,7 @@ fn row_text(r: &Row) -> String {
         Ok(n) => {
             let missed = n.missed();
             format!(
-                "| {} | {} | {} | {:.3} / {:.3} | {:.2} / {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {} | {} |",
+                "| {} | {} | {} | {:.3} / {:.3} | {:.2} / {:.2} | {:.2} | {} | {} | {:.2} | {} | {} | {} |",
                 cell(&r.name),
                 n.faces_in,
                 n.faces_out,
@@ -343,7 +533,7 @@ fn row_text(r: &Row) -> String {
                 n.flips,
                 n.patches,
                 n.seconds,
-                r.wall,
+                seconds(r.wall),
                 n.peak_mb.map_or("-".into(), |m| format!("{m:.0}")),
                 if missed.is_empty() {
                     "met".to_string()
@@ -353,15 +543,23 @@ fn row_text(r: &Row) -> String {
             )
         }
         Err(e) => format!(
-            "| {} | - | - | - | - | - | - | - | - | {:.2} | - | FAILED: {} |",
+            "| {} | - | - | - | - | - | - | - | - | {} | - | FAILED: {} |",
             cell(&r.name),
-            r.wall,
+            seconds(r.wall),
             cell(e)
         ),
     }
 }
 
-fn table(rows: &[Row], remesh_args: &[String]) -> String {
+/// A time in seconds for a cell, `-` when there is none.
+fn seconds(t: Option<f64>) -> String {
+    t.map_or("-".to_string(), |t| format!("{t:.2}"))
+}
+
+/// `remesh.md`: conemesh's table, then conemesh and MMG side by side, then (with several
+/// `--threads`) the thread counts.
+fn table(rows: &[MeshRows], folder: &Folder, header: &tools::Header) -> String {
+    let remesh_args = &folder.remesh_args;
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -376,8 +574,12 @@ fn table(rows: &[Row], remesh_args: &[String]) -> String {
          run's own time (reading, metric, Algorithm 1 with its certificates), `wall s` the whole \
          process's (also `eval` and writing); \
          peak MiB is the process's peak resident memory (VmHWM). Targets (issue 9): q_avg ≥ {TARGET_Q_AVG}, \
-         θ_avg ≥ {TARGET_THETA_AVG}°, 0 flips, Hausdorff ≤ {} %.\n",
-        100.0 * TARGET_HAUSDORFF_REL
+         θ_avg ≥ {TARGET_THETA_AVG}°, 0 flips, Hausdorff ≤ {} %.{}\n",
+        100.0 * TARGET_HAUSDORFF_REL,
+        match folder.threads.first() {
+            Some(n) => format!(" Every run here with `--threads {n}`."),
+            None => String::new(),
+        }
     );
     let _ = writeln!(
         s,
@@ -385,7 +587,66 @@ fn table(rows: &[Row], remesh_args: &[String]) -> String {
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for r in rows {
-        let _ = writeln!(s, "{}", row_text(r));
+        let _ = writeln!(s, "{}", row_text(&r.row));
+    }
+    side_by_side::section(
+        &mut s,
+        rows.iter().map(|r| (r.row.name.as_str(), &r.pair)),
+        folder,
+        header,
+    );
+    if folder.threads.len() > 1 {
+        threads_section(&mut s, rows, &folder.threads);
     }
     s
+}
+
+/// The thread counts' table: each count's own time, the speed-up over the first count, and
+/// whether the output is the first count's byte for byte.
+fn threads_section(s: &mut String, rows: &[MeshRows], counts: &[usize]) {
+    let first = counts[0];
+    let others = &counts[1..];
+    let _ = writeln!(s, "\n## Thread counts\n");
+    let _ = writeln!(
+        s,
+        "`remesh s` (the run's own time, from its report) of `conemesh remesh MESH --threads N` \
+         per count N, run one after the other; speed-up = the time at {first} over the time at N; \
+         same output = the output file is byte for byte the one at {first} (it must not depend on \
+         the thread count).\n"
+    );
+    let mut head = format!("| mesh | s at {first} |");
+    let mut rule = "|---|---|".to_string();
+    for n in others {
+        let _ = write!(
+            head,
+            " s at {n} | speed-up {first}→{n} | same output at {n} |"
+        );
+        rule.push_str("---|---|---|");
+    }
+    let _ = writeln!(s, "{head}\n{rule}");
+    for r in rows {
+        let base = r.row.outcome.as_ref().map(|n| n.seconds);
+        let mut line = format!(
+            "| {} | {} |",
+            cell(&r.row.name),
+            match &base {
+                Ok(t) => format!("{t:.2}"),
+                Err(_) => "FAILED".to_string(),
+            }
+        );
+        for t in &r.threads {
+            let (time, speedup) = match (&base, &t.outcome) {
+                (Ok(b), Ok(o)) => (format!("{o:.2}"), format!("{:.2}", b / o)),
+                (_, Ok(o)) => (format!("{o:.2}"), "-".to_string()),
+                (_, Err(e)) => (format!("FAILED: {}", cell(e)), "-".to_string()),
+            };
+            let same = match t.same {
+                Some(true) => "yes",
+                Some(false) => "NO",
+                None => "-",
+            };
+            let _ = write!(line, " {time} | {speedup} | {same} |");
+        }
+        let _ = writeln!(s, "{line}");
+    }
 }

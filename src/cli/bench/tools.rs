@@ -1,0 +1,415 @@
+//! What the benchmarks that run other tools share (`--suite analytic` and the folder bench
+//! with `--mmg`): finding MMG and its version, running a child with a timeout and timing it,
+//! and scoring an output by `conemesh eval`, so that every tool is measured by one yardstick.
+
+use super::{cell, error_line};
+use anyhow::ensure;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
+
+/// MMG's surface remesher, looked up on PATH.
+pub(super) const MMG_NAME: &str = "mmgs_O3";
+/// The environment variable naming MMG when it is not on PATH.
+pub(super) const MMG_ENV: &str = "CONEMESH_MMG";
+/// The issue-17 protocol (issue 19 runs it on the shared meshes too): no ridge detection
+/// (`-nr`: the suite's surfaces are smooth or flat, their boundaries are kept as boundaries
+/// anyway), no geometric approximation control (`-hausd 10`, far above any of the sizes) and
+/// no gradation (`-hgrad -1`), so MMG follows the given metric alone, as conemesh does;
+/// `-v -1` silences it.
+pub(super) const MMG_PROTOCOL: [&str; 7] = ["-nr", "-hausd", "10", "-hgrad", "-1", "-v", "-1"];
+
+/// The MMG binary: `--mmg PATH`, else `mmgs_O3` on PATH, else `$CONEMESH_MMG`; `None` when
+/// there is none. A named binary that does not exist is an error naming it.
+pub(super) fn find_mmg(option: Option<&Path>) -> anyhow::Result<Option<PathBuf>> {
+    if let Some(p) = option {
+        ensure!(p.is_file(), "--mmg {}: no such file", p.display());
+        return Ok(Some(p.to_path_buf()));
+    }
+    let on_path = std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|d| d.join(MMG_NAME))
+            .find(|p| is_executable(p))
+    });
+    if on_path.is_some() {
+        return Ok(on_path);
+    }
+    match std::env::var_os(MMG_ENV) {
+        Some(v) if !v.is_empty() => {
+            let p = PathBuf::from(v);
+            ensure!(p.is_file(), "{MMG_ENV}={}: no such file", p.display());
+            Ok(Some(p))
+        }
+        _ => Ok(None),
+    }
+}
+
+fn is_executable(p: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    p.metadata()
+        .is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+}
+
+/// MMG's release line from `-h` (e.g. "MMGS, Release 5.8.0 (Oct. 30, 2024)"), or why not.
+pub(super) fn mmg_version(mmg: &Path, timeout: Duration) -> String {
+    match run_timed(Command::new(mmg).arg("-h"), timeout) {
+        Ok(f) => {
+            let text = String::from_utf8_lossy(&f.stdout).into_owned()
+                + &String::from_utf8_lossy(&f.stderr);
+            text.lines()
+                .find(|l| l.contains("Release"))
+                .map(|l| l.trim().trim_start_matches("--").trim().to_string())
+                .unwrap_or_else(|| "version not printed by -h".to_string())
+        }
+        Err(e) => format!("version unknown ({e})"),
+    }
+}
+
+/// The 1-minute load average (`/proc/loadavg`), where there is one.
+pub(super) fn load_average() -> Option<String> {
+    let s = std::fs::read_to_string("/proc/loadavg").ok()?;
+    Some(s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+}
+
+/// What a table's preamble says about the run: MMG's version, the machine's load.
+pub(super) struct Header {
+    pub mmg_version: Option<String>,
+    pub load_start: Option<String>,
+    pub load_end: Option<String>,
+}
+
+impl Header {
+    /// Before the first run.
+    pub fn start(mmg: Option<&Path>, timeout: Duration) -> Header {
+        Header {
+            mmg_version: mmg.map(|p| mmg_version(p, timeout)),
+            load_start: load_average(),
+            load_end: None,
+        }
+    }
+
+    /// After the last run.
+    pub fn end(self) -> Header {
+        Header {
+            load_end: load_average(),
+            ..self
+        }
+    }
+}
+
+/// A finished child process.
+pub(super) struct Finished {
+    pub status: ExitStatus,
+    pub stdout: Vec<u8>,
+    pub stderr: Vec<u8>,
+    /// Wall-clock seconds from spawn to exit.
+    pub wall: f64,
+}
+
+/// Run `cmd` (stdin closed, stdout and stderr captured) for at most `timeout`; a child still
+/// running then is killed. The wall time is the whole process's, spawn to exit.
+pub(super) fn run_timed(cmd: &mut Command, timeout: Duration) -> Result<Finished, String> {
+    let t0 = Instant::now();
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot start {:?}: {e}", cmd.get_program()))?;
+    // Readers drain the pipes while we wait, so a chatty child never blocks on a full pipe.
+    let drain = |pipe: Option<Box<dyn Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut buf = Vec::new();
+            if let Some(mut p) = pipe {
+                let _ = p.read_to_end(&mut buf);
+            }
+            buf
+        })
+    };
+    let out = drain(
+        child
+            .stdout
+            .take()
+            .map(|p| Box::new(p) as Box<dyn Read + Send>),
+    );
+    let err = drain(
+        child
+            .stderr
+            .take()
+            .map(|p| Box::new(p) as Box<dyn Read + Send>),
+    );
+    // Poll with a short, growing sleep: the timing error stays below a few milliseconds.
+    let mut nap = Duration::from_micros(200);
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(status)) => break status,
+            Ok(None) if t0.elapsed() > timeout => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return Err(format!(
+                    "timed out after {} s (killed)",
+                    timeout.as_secs_f64()
+                ));
+            }
+            Ok(None) => {
+                std::thread::sleep(nap);
+                nap = (nap * 2).min(Duration::from_millis(5));
+            }
+            Err(e) => return Err(format!("waiting for {:?}: {e}", cmd.get_program())),
+        }
+    };
+    let wall = t0.elapsed().as_secs_f64();
+    Ok(Finished {
+        status,
+        stdout: out.join().unwrap_or_default(),
+        stderr: err.join().unwrap_or_default(),
+        wall,
+    })
+}
+
+/// One tool's numbers on one case, from `conemesh eval --json`.
+pub(super) struct Score {
+    pub faces: u64,
+    pub q_min: f64,
+    pub q_avg: f64,
+    pub theta_min: f64,
+    pub theta_avg: f64,
+    pub in_range: f64,
+    pub mean_ratio: f64,
+    pub hausdorff_rel: f64,
+    pub flips: usize,
+    pub self_intersections: usize,
+    pub topology_kept: bool,
+}
+
+impl Score {
+    pub(super) fn from_eval(json: &serde_json::Value) -> Result<Score, String> {
+        let get = |path: &[&str]| -> Result<&serde_json::Value, String> {
+            path.iter()
+                .try_fold(json, |v, k| v.get(k))
+                .ok_or_else(|| format!("the eval report has no `{}`", path.join(".")))
+        };
+        let f = |path: &[&str]| -> Result<f64, String> {
+            get(path)?
+                .as_f64()
+                .ok_or_else(|| format!("`{}` is not a number", path.join(".")))
+        };
+        let len = |path: &[&str]| -> Result<usize, String> {
+            get(path)?
+                .as_array()
+                .map(|a| a.len())
+                .ok_or_else(|| format!("`{}` is not a list", path.join(".")))
+        };
+        Ok(Score {
+            faces: get(&["report", "output", "faces"])?
+                .as_u64()
+                .ok_or("`report.output.faces` is not a count")?,
+            q_min: f(&["report", "output_quality", "q_min"])?,
+            q_avg: f(&["report", "output_quality", "q_avg"])?,
+            theta_min: f(&["report", "output_quality", "theta_min"])?,
+            theta_avg: f(&["report", "output_quality", "theta_avg"])?,
+            in_range: f(&["report", "output_conformity", "fraction_in_range"])?,
+            mean_ratio: f(&["report", "output_conformity", "mean"])?,
+            hausdorff_rel: f(&["report", "distance", "hausdorff_rel"])?,
+            flips: len(&["report", "flips"])?,
+            self_intersections: len(&["report", "self_intersections"])?,
+            topology_kept: get(&["report", "topology_kept"])?
+                .as_bool()
+                .ok_or("`report.topology_kept` is not a boolean")?,
+        })
+    }
+}
+
+/// How one tool's run on one case went.
+pub(super) enum Outcome {
+    /// No MMG binary was found.
+    NotInstalled,
+    /// The tool or its eval failed (`wall`: the tool's time when it ran to the end).
+    Failed { error: String, wall: Option<f64> },
+    /// Ran and scored; `own` is conemesh's own time from its report (no eval, no writing).
+    Done {
+        wall: f64,
+        own: Option<f64>,
+        score: Score,
+    },
+}
+
+/// One tool's run on one input.
+pub(super) struct ToolRun {
+    pub tool: &'static str,
+    pub outcome: Outcome,
+}
+
+/// conemesh and MMG on one input.
+pub(super) struct Pair {
+    pub conemesh: ToolRun,
+    pub mmg: ToolRun,
+}
+
+impl Pair {
+    /// conemesh's wall time over MMG's, when both ran.
+    pub fn time_ratio(&self) -> Option<f64> {
+        time_ratio(&self.conemesh.outcome, &self.mmg.outcome)
+    }
+}
+
+/// conemesh's wall time over MMG's, when both ran.
+pub(super) fn time_ratio(conemesh: &Outcome, mmg: &Outcome) -> Option<f64> {
+    match (conemesh, mmg) {
+        (Outcome::Done { wall: c, .. }, Outcome::Done { wall: m, .. }) if *m > 0.0 => Some(c / m),
+        _ => None,
+    }
+}
+
+/// The header and separator of the results table whose first column is `first`.
+pub(super) fn results_header(first: &str) -> String {
+    format!(
+        "| {first} | tool | faces | q_min / q_avg | θ_min / θ_avg (°) | in range % | mean L/L_tar | Hausdorff % | flips | valid | wall s | remesh s | conemesh/MMG |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    )
+}
+
+/// One tool's Markdown row under [`results_header`] (`ratio`: [`time_ratio`], shown on the
+/// conemesh row).
+pub(super) fn tool_row(name: &str, t: &ToolRun, ratio: Option<f64>) -> String {
+    let name = cell(name);
+    let ratio = match (t.tool, ratio) {
+        ("conemesh", Some(r)) => format!("{r:.2}"),
+        _ => "-".to_string(),
+    };
+    match &t.outcome {
+        Outcome::NotInstalled => format!(
+            "| {name} | {} | not installed | - | - | - | - | - | - | - | - | - | - |",
+            t.tool
+        ),
+        Outcome::Failed { error, wall } => format!(
+            "| {name} | {} | FAILED: {} | - | - | - | - | - | - | - | {} | - | - |",
+            t.tool,
+            cell(error),
+            wall.map_or("-".to_string(), |w| format!("{w:.2}"))
+        ),
+        Outcome::Done {
+            wall,
+            own,
+            score: s,
+        } => {
+            let valid = match (s.self_intersections, s.topology_kept) {
+                (0, true) => "yes".to_string(),
+                (0, false) => "topology changed".to_string(),
+                (n, true) => format!("{n} self-int"),
+                (n, false) => format!("{n} self-int, topology changed"),
+            };
+            format!(
+                "| {name} | {} | {} | {:.3} / {:.3} | {:.2} / {:.2} | {:.1} | {:.2} | {:.3} | {} | {valid} | {wall:.2} | {} | {ratio} |",
+                t.tool,
+                s.faces,
+                s.q_min,
+                s.q_avg,
+                s.theta_min,
+                s.theta_avg,
+                100.0 * s.in_range,
+                s.mean_ratio,
+                100.0 * s.hausdorff_rel,
+                s.flips,
+                own.map_or("-".to_string(), |o| format!("{o:.2}"))
+            )
+        }
+    }
+}
+
+/// Run one tool that writes `output`, then score that output with `score`; the tool's and the
+/// scoring's stdout and stderr go to `log`. `own` is left `None` for the caller to fill.
+pub(super) fn run_and_score(
+    tool: &str,
+    cmd: &mut Command,
+    output: &Path,
+    timeout: Duration,
+    log: &mut Vec<u8>,
+    score: impl FnOnce(&mut Vec<u8>) -> Result<Score, String>,
+) -> Outcome {
+    let ran = run_timed(cmd, timeout).and_then(|f| {
+        log.extend_from_slice(&f.stdout);
+        log.extend_from_slice(&f.stderr);
+        if !f.status.success() {
+            return Err(format!(
+                "{tool} failed ({}): {}",
+                f.status,
+                error_line(&String::from_utf8_lossy(&f.stderr))
+            ));
+        }
+        if !output.is_file() {
+            return Err(format!(
+                "{tool} exited without writing {}",
+                output.display()
+            ));
+        }
+        Ok(f.wall)
+    });
+    match ran {
+        Err(error) => Outcome::Failed { error, wall: None },
+        Ok(wall) => match score(log) {
+            Err(error) => Outcome::Failed {
+                error,
+                wall: Some(wall),
+            },
+            Ok(score) => Outcome::Done {
+                wall,
+                own: None,
+                score,
+            },
+        },
+    }
+}
+
+/// The yardstick: `conemesh eval --input INPUT --output OUTPUT [--metric M] --ltar L --json
+/// JSON` run by `exe` (this executable), its stdout and stderr appended to `log`.
+pub(super) struct Eval<'a> {
+    pub exe: &'a Path,
+    pub input: &'a Path,
+    pub metric: Option<&'a Path>,
+    /// L_tar as given to `--ltar` (metric length, input file units).
+    pub ltar: String,
+    pub timeout: Duration,
+}
+
+impl Eval<'_> {
+    pub fn score(&self, output: &Path, json: &Path, log: &mut Vec<u8>) -> Result<Score, String> {
+        let mut cmd = Command::new(self.exe);
+        cmd.arg("eval")
+            .arg("--input")
+            .arg(self.input)
+            .arg("--output")
+            .arg(output);
+        if let Some(m) = self.metric {
+            cmd.arg("--metric").arg(m);
+        }
+        cmd.args(["--ltar", &self.ltar, "--json"]).arg(json);
+        let f = run_timed(&mut cmd, self.timeout).map_err(|e| format!("eval {e}"))?;
+        log.extend_from_slice(b"\n--- conemesh eval ---\n");
+        log.extend_from_slice(&f.stdout);
+        log.extend_from_slice(&f.stderr);
+        if !f.status.success() {
+            return Err(format!(
+                "eval failed ({}): {}",
+                f.status,
+                error_line(&String::from_utf8_lossy(&f.stderr))
+            ));
+        }
+        let text = std::fs::read_to_string(json)
+            .map_err(|e| format!("reading {}: {e}", json.display()))?;
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", json.display()))?;
+        Score::from_eval(&value)
+    }
+}
+
+/// conemesh's own time (`seconds` of its report: reading, metric, Algorithm 1 with its
+/// certificates; not its built-in eval nor writing).
+pub(super) fn own_seconds(report: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(report).ok()?;
+    serde_json::from_str::<serde_json::Value>(&text)
+        .ok()?
+        .get("seconds")?
+        .as_f64()
+}
