@@ -95,9 +95,9 @@ pub struct RemeshArgs {
     pub write_metric: Option<PathBuf>,
     /// Write the metric the run remeshes to at the input vertices (Medit .sol, file units,
     /// one tensor per vertex of the input file, of the repaired input with `--repair`): the
-    /// curvature or user metric with the size
-    /// controls and the a-priori fidelity scaling, over L_tar² (MMG's `-ltar 1`: an edge on
-    /// target has length 1) and SPD in 3D, so MMG can be run on the input with it.
+    /// curvature or user metric with the size controls and the a-priori fidelity scaling,
+    /// over L_tar² (MMG's `-ltar 1`: an edge on target has length 1) and SPD in 3D, so MMG
+    /// can be run on the input with it.
     #[arg(long, value_name = "FILE.sol")]
     pub write_input_metric: Option<PathBuf>,
     /// Directory for offending patches when a certificate fails (default: the output's).

@@ -121,6 +121,33 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
             faces.push(int(tok, l, path, F)?);
             got += 1;
         }
+        // OFF is read as a token stream by most readers (libigl's `readOFF` among them), and
+        // some writers break a long face over lines: a face that ends its line short takes
+        // the next lines' indices, as long as each such line holds nothing else.
+        let mut at = l;
+        while got < k {
+            let Some((l2, s2)) = lines.next() else {
+                break;
+            };
+            let toks: Vec<&str> = s2.split_ascii_whitespace().collect();
+            if got + toks.len() as u64 > k {
+                return Err(IoError::Parse {
+                    path: path.to_string(),
+                    format: F,
+                    line: l2,
+                    message: format!(
+                        "face {f} announces {k} vertices; it continues from line {l} on this \
+                         line, which holds more than the rest of its indices"
+                    ),
+                });
+            }
+            for tok in toks {
+                faces.push(int(tok, l2, path, F)?);
+                got += 1;
+            }
+            at = l2;
+        }
+        let l = at;
         if got < k {
             return Err(IoError::Parse {
                 path: path.to_string(),

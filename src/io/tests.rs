@@ -33,6 +33,25 @@ fn off_counts_on_magic_line_and_coff_extras() -> Result<(), IoError> {
 }
 
 #[test]
+fn off_faces_broken_over_lines_are_read_as_a_token_stream() -> Result<(), IoError> {
+    // As libigl's tutorial data `inspired_mesh_quads_*.off` writes them: a face's indices on
+    // the lines after its count.
+    let m = rd(
+        "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 \n1 \n2\n3\n3 0 2 3\n",
+        Format::Off,
+    )?;
+    assert_eq!(m.mesh.n_faces(), 3);
+    // A continuation line that holds more than the face's indices is refused by line.
+    let e = rd(
+        "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1\n2 3 3\n0 2 3\n",
+        Format::Off,
+    )
+    .unwrap_err();
+    assert!(matches!(e, IoError::Parse { line: 8, .. }), "{e}");
+    Ok(())
+}
+
+#[test]
 fn off_errors_are_named() {
     let e = rd("OFF\n3 1 0\n0 0 0\n1 0 0\n", Format::Off).unwrap_err();
     assert_eq!(e.kind(), "truncated", "{e}");

@@ -288,8 +288,8 @@ impl LoopState {
         true
     }
 
-    /// Note whether the working mesh is over the run's face budget: [`super::RemeshOptions::face_budget`] times the
-    /// larger of the input's face count and the output expected with the a-priori fidelity
+    /// Note whether the working mesh is over the run's face budget:
+    /// [`super::RemeshOptions::face_budget`] times the larger of the input's face count and the output expected with the a-priori fidelity
     /// scaling. A run's cost grows with its faces; where the fidelity control keeps
     /// refining without reaching its tolerance (a crease no feature line follows, cut by
     /// every chord), this bounds it, and the run ends `Ok` with a warning.
