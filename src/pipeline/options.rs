@@ -193,7 +193,7 @@ impl RemeshOptions {
         if self.batch == 0 {
             return Err("the patch batch must hold at least 1 patch".to_string());
         }
-        if !(self.face_budget > 0.0) {
+        if self.face_budget.is_nan() || self.face_budget <= 0.0 {
             return Err(format!(
                 "face budget {} is not a number > 0",
                 self.face_budget
