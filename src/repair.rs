@@ -560,18 +560,8 @@ mod tests {
     fn a_soup_is_welded_into_the_surface() {
         // Every face with its own three vertices (an STL soup), one face reversed.
         let m = generators::torus(1.0, 0.4, 10, 6);
-        let mut positions = Vec::new();
-        let mut tris = Vec::new();
-        for f in m.faces() {
-            let base = positions.len() as u32;
-            positions.extend(m.face_points(f));
-            tris.push(if f.0 == 5 {
-                tri(base, base + 2, base + 1)
-            } else {
-                tri(base, base + 1, base + 2)
-            });
-        }
-        let soup = TriMesh::new(positions, tris).unwrap();
+        let mut soup = generators::triangle_soup(&m);
+        soup.triangles[5].swap(1, 2);
         let r = repair(&soup, &RepairOptions::default()).unwrap();
         assert_eq!(r.mesh.n_vertices(), m.n_vertices());
         assert_eq!(r.mesh.n_faces(), m.n_faces());
@@ -670,30 +660,7 @@ mod tests {
 
     #[test]
     fn a_moebius_band_is_refused_naming_an_edge() {
-        // A strip of 2k triangles whose ends are glued with a half twist.
-        let k = 8usize;
-        let mut positions = Vec::new();
-        for i in 0..k {
-            let t = std::f64::consts::TAU * i as f64 / k as f64;
-            let (c, s) = ((t / 2.0).cos(), (t / 2.0).sin());
-            let radial = nalgebra::Vector3::new(t.cos(), t.sin(), 0.0);
-            for w in [-0.3, 0.3] {
-                let p = 2.0 * radial + w * (c * radial + s * nalgebra::Vector3::z());
-                positions.push(Point3::from(p));
-            }
-        }
-        let mut tris = Vec::new();
-        for i in 0..k {
-            let (a, b) = (2 * i as u32, 2 * i as u32 + 1);
-            let (c, d) = if i + 1 < k {
-                (a + 2, b + 2)
-            } else {
-                (1, 0) // the half twist
-            };
-            tris.push(tri(a, c, b));
-            tris.push(tri(b, c, d));
-        }
-        let m = TriMesh::new(positions, tris).unwrap();
+        let m = generators::moebius_band(8);
         match repair(&m, &RepairOptions::default()) {
             Err(RepairError::NonOrientable { .. }) => {}
             other => panic!("expected a refusal, got {other:?}"),

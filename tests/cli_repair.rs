@@ -152,14 +152,7 @@ fn two_surfaces_touching_at_a_vertex_are_split_and_remeshed_apart() {
 fn a_users_metric_follows_the_welded_vertices() {
     // The torus as a soup (three vertices per face) with a user metric per soup vertex.
     let m = generators::torus(1.0, 0.4, 12, 6);
-    let mut positions = Vec::new();
-    let mut tris = Vec::new();
-    for f in m.faces() {
-        let b = positions.len() as u32;
-        positions.extend(m.face_points(f));
-        tris.push([VertexId(b), VertexId(b + 1), VertexId(b + 2)]);
-    }
-    let soup = TriMesh::new(positions, tris).expect("soup");
+    let soup = generators::triangle_soup(&m);
     let dir = tempfile::tempdir().expect("temp dir");
     let input = dir.path().join("soup.obj");
     conemesh::io::write_mesh(&input, &soup).expect("write");
@@ -190,24 +183,7 @@ fn a_users_metric_follows_the_welded_vertices() {
 
 #[test]
 fn a_moebius_band_is_refused_by_name_with_no_output() {
-    let k = 12usize;
-    let mut positions = Vec::new();
-    for i in 0..k {
-        let t = std::f64::consts::TAU * i as f64 / k as f64;
-        let radial = nalgebra::Vector3::new(t.cos(), t.sin(), 0.0);
-        let across = (t / 2.0).cos() * radial + (t / 2.0).sin() * nalgebra::Vector3::z();
-        for w in [-0.3, 0.3] {
-            positions.push(nalgebra::Point3::from(2.0 * radial + w * across));
-        }
-    }
-    let mut tris = Vec::new();
-    for i in 0..k {
-        let (a, b) = (2 * i as u32, 2 * i as u32 + 1);
-        let (c, d) = if i + 1 < k { (a + 2, b + 2) } else { (1, 0) };
-        tris.push([VertexId(a), VertexId(c), VertexId(b)]);
-        tris.push([VertexId(b), VertexId(c), VertexId(d)]);
-    }
-    let m = TriMesh::new(positions, tris).expect("mesh");
+    let m = generators::moebius_band(12);
     let dir = tempfile::tempdir().expect("temp dir");
     let input = dir.path().join("moebius.ply");
     conemesh::io::write_mesh(&input, &m).expect("write");

@@ -520,6 +520,38 @@ pub fn perturb<R: Rng>(mesh: &TriMesh, amplitude: f64, rng: &mut R) -> TriMesh {
     m
 }
 
+/// Broken inputs, for the repair's tests (the exceptions to this module's rule): every face of
+/// `mesh` with three vertices of its own, at the same positions (an STL-style soup).
+pub fn triangle_soup(mesh: &TriMesh) -> TriMesh {
+    let positions = mesh.faces().flat_map(|f| mesh.face_points(f)).collect();
+    let tris = (0..mesh.n_faces())
+        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+        .collect();
+    build(positions, tris)
+}
+
+/// A Möbius band of `2k` triangles (radius 2, width 0.6): a strip whose ends are glued with a
+/// half twist, so it cannot be oriented (another exception to this module's rule).
+pub fn moebius_band(k: usize) -> TriMesh {
+    let mut positions = Vec::with_capacity(2 * k);
+    for i in 0..k {
+        let t = std::f64::consts::TAU * i as f64 / k as f64;
+        let radial = Vector3::new(t.cos(), t.sin(), 0.0);
+        let across = (t / 2.0).cos() * radial + (t / 2.0).sin() * Vector3::z();
+        for w in [-0.3, 0.3] {
+            positions.push(Point3::from(2.0 * radial + w * across));
+        }
+    }
+    let mut tris = Vec::with_capacity(2 * k);
+    for i in 0..k {
+        let (a, b) = (2 * i, 2 * i + 1);
+        let (c, d) = if i + 1 < k { (a + 2, b + 2) } else { (1, 0) }; // the half twist
+        tris.push([a, c, b]);
+        tris.push([b, c, d]);
+    }
+    build(positions, tris)
+}
+
 /// The built-in default surface of the CLI: a torus with major radius 1 and tube radius
 /// 0.35 (anisotropic curvature: the tube direction is curved ~3× more than the ring).
 pub fn default_surface() -> TriMesh {
