@@ -303,9 +303,9 @@ fn kept_faces(
     (faces, tris)
 }
 
-/// Across edge `i` of each kept face (from corner `i` to corner `i + 1`): the other face
-/// and whether it traverses the edge in the same direction, for edges with exactly two
-/// faces. With `cut`, edges of three or more faces are recorded in the log and glue
+/// Across edge `i` of each kept face (from corner `i` to corner `i + 1`): the other face's
+/// half-edge on it (`3·face + corner`) and whether it traverses the edge in the same
+/// direction, for edges with exactly two faces. With `cut`, edges of three or more faces are recorded in the log and glue
 /// nothing; without, they are left for the final certificate to name.
 fn glued_edges(
     tris: &[[VertexId; 3]],
@@ -332,8 +332,8 @@ fn glued_edges(
             2 => {
                 let (h, g) = (hes[i].2, hes[i + 1].2);
                 let same = from(h) == from(g);
-                adjacency[(h / 3) as usize][(h % 3) as usize] = Some((g / 3, same));
-                adjacency[(g / 3) as usize][(g % 3) as usize] = Some((h / 3, same));
+                adjacency[(h / 3) as usize][(h % 3) as usize] = Some((g, same));
+                adjacency[(g / 3) as usize][(g % 3) as usize] = Some((h, same));
             }
             1 => {}
             _ if cut => log.cut_edges.push(EdgeKey(hes[i].0, hes[i].1)),
@@ -365,8 +365,8 @@ fn orient(
         while let Some(k) = queue.pop_front() {
             let fk = flip[k] == Some(true);
             for (i, across) in adjacency[k].iter().enumerate() {
-                let Some((g, same)) = *across else { continue };
-                let g = g as usize;
+                let Some((h, same)) = *across else { continue };
+                let g = (h / 3) as usize;
                 // Two faces agree when they traverse their shared edge in opposite
                 // directions, so a face across a same-direction edge must flip relative
                 // to this one.
@@ -413,15 +413,19 @@ fn split_fans(
     Vec<VertexId>,
     Vec<[VertexId; 3]>,
 ) {
-    let corner = |k: usize, v: VertexId| 3 * k + tris[k].iter().position(|&w| w == v).unwrap();
+    // Corner `c` of face `k` is `3k + c`. Half-edge `3k + i` runs from corner `i` to corner
+    // `i + 1`; the other face's half-edge `3g + j` on the same edge starts at the same vertex
+    // when both run the same way, at the other one otherwise.
+    let next = |c: usize| c - c % 3 + (c % 3 + 1) % 3;
     let mut fans = UnionFind::new(3 * tris.len());
-    for (k, t) in tris.iter().enumerate() {
+    for k in 0..tris.len() {
         for (i, across) in adjacency[k].iter().enumerate() {
-            if let Some((g, _)) = *across {
-                let g = g as usize;
-                for v in [t[i], t[(i + 1) % 3]] {
-                    fans.union(corner(k, v), corner(g, v));
-                }
+            if let Some((h, same)) = *across {
+                let (a, b) = (3 * k + i, next(3 * k + i));
+                let (c, d) = (h as usize, next(h as usize));
+                let (at_a, at_b) = if same { (c, d) } else { (d, c) };
+                fans.union(a, at_a);
+                fans.union(b, at_b);
             }
         }
     }
@@ -523,7 +527,7 @@ mod tests {
     #[test]
     fn a_valid_mesh_is_returned_unchanged() {
         let m = generators::torus(1.0, 0.4, 12, 8);
-        let r = repair(&m, &RepairOptions::default()).unwrap();
+        let r = repair(&m, &RepairOptions::default()).expect("repairs");
         assert!(r.log.is_empty(), "{}", r.log.summary());
         assert_eq!(r.mesh, m);
     }
@@ -537,7 +541,7 @@ mod tests {
             shuffled.triangles[f].swap(0, 1);
         }
         assert!(!certified(&shuffled));
-        let r = repair(&shuffled, &RepairOptions::default()).unwrap();
+        let r = repair(&shuffled, &RepairOptions::default()).expect("repairs");
         // A third of the faces were reversed, so the other two thirds' orientation wins:
         // exactly the reversed faces are flipped back, and the mesh is the original's
         // (up to the rotation of each flipped triangle's corners).
@@ -562,7 +566,7 @@ mod tests {
         let m = generators::torus(1.0, 0.4, 10, 6);
         let mut soup = generators::triangle_soup(&m);
         soup.triangles[5].swap(1, 2);
-        let r = repair(&soup, &RepairOptions::default()).unwrap();
+        let r = repair(&soup, &RepairOptions::default()).expect("repairs");
         assert_eq!(r.mesh.n_vertices(), m.n_vertices());
         assert_eq!(r.mesh.n_faces(), m.n_faces());
         assert_eq!(r.log.welded.len(), soup.n_vertices() - m.n_vertices());
@@ -589,9 +593,9 @@ mod tests {
             p(1.0, 2.0),
         ];
         let tris = vec![tri(0, 1, 2), tri(0, 2, 3), tri(2, 4, 5), tri(2, 5, 6)];
-        let m = TriMesh::new(positions, tris).unwrap();
+        let m = TriMesh::new(positions, tris).expect("valid arrays");
         assert!(!certified(&m));
-        let r = repair(&m, &RepairOptions::default()).unwrap();
+        let r = repair(&m, &RepairOptions::default()).expect("repairs");
         assert_eq!(
             r.log.split_vertices,
             vec![Split {
@@ -616,8 +620,8 @@ mod tests {
             Point3::new(0.5, -0.5, -0.8),
         ];
         let tris = vec![tri(0, 1, 2), tri(1, 0, 3), tri(0, 1, 4)];
-        let m = TriMesh::new(positions, tris).unwrap();
-        let r = repair(&m, &RepairOptions::default()).unwrap();
+        let m = TriMesh::new(positions, tris).expect("valid arrays");
+        let r = repair(&m, &RepairOptions::default()).expect("repairs");
         assert_eq!(r.log.cut_edges, vec![EdgeKey(VertexId(0), VertexId(1))]);
         assert!(certified(&r.mesh));
         let topo = Topology::build(&r.mesh);
@@ -643,7 +647,7 @@ mod tests {
         m.triangles.push(tri(base, base + 1, base + 2));
         let t1 = m.triangles[1];
         m.triangles.push([t1[0], VertexId(0), VertexId(base + 3)]);
-        let r = repair(&m, &RepairOptions::default()).unwrap();
+        let r = repair(&m, &RepairOptions::default()).expect("repairs");
         let reasons: Vec<(FaceId, DropReason)> = r
             .log
             .dropped_faces
@@ -688,8 +692,8 @@ mod tests {
     fn metric_values_follow_their_vertices() {
         let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
         let positions = vec![p(0.0, 0.0), p(1.0, 0.0), p(0.0, 1.0), p(1.0, 0.0)];
-        let m = TriMesh::new(positions, vec![tri(0, 3, 2)]).unwrap();
-        let r = repair(&m, &RepairOptions::default()).unwrap();
+        let m = TriMesh::new(positions, vec![tri(0, 3, 2)]).expect("valid arrays");
+        let r = repair(&m, &RepairOptions::default()).expect("repairs");
         // v3 is welded into v1 (same point): v1's value is the one carried.
         assert_eq!(r.vertex_values(&[10, 11, 12, 13]), vec![10, 11, 12]);
         assert_eq!(

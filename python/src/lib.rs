@@ -317,17 +317,25 @@ fn remesh_job(
     // The output paths first, as the CLI checks them: a bad path costs no remesh.
     cli_remesh::check_output_paths(args, false)
         .map_err(|e| Failure::new("FileError", keywordify(&format!("{e:#}"))))?;
-    let repaired =
-        cli_remesh::repaired_input(args, mesh.clone(), metric.map(<[_]>::to_vec), "the input")
-            .map_err(
-                |e| match e.downcast_ref::<conemesh::repair::RepairError>() {
-                    Some(conemesh::repair::RepairError::Unrepaired(v)) => {
-                        errors::with_invariant(Failure::input(format!("{e:#}")), v)
-                    }
-                    _ => Failure::input(format!("{e:#}")),
-                },
-            )?;
-    let (mesh, metric, repair) = (&repaired.mesh, repaired.metric.as_deref(), &repaired.repair);
+    // Without `repair=True` the caller's arrays are used as they are (no copy).
+    let repaired = match args.repair {
+        false => None,
+        true => Some(
+            cli_remesh::repaired_input(args, mesh.clone(), metric.map(<[_]>::to_vec), "the input")
+                .map_err(
+                    |e| match e.downcast_ref::<conemesh::repair::RepairError>() {
+                        Some(conemesh::repair::RepairError::Unrepaired(v)) => {
+                            errors::with_invariant(Failure::input(format!("{e:#}")), v)
+                        }
+                        _ => Failure::input(format!("{e:#}")),
+                    },
+                )?,
+        ),
+    };
+    let (mesh, metric, repair) = match &repaired {
+        Some(r) => (&r.mesh, r.metric.as_deref(), r.repair.as_ref()),
+        None => (mesh, metric, None),
+    };
     // The pipeline refuses a non-manifold input with a message; certify it here first so
     // that the exception names the elements, in the caller's numbering.
     let topo = conemesh::Topology::build(mesh);
