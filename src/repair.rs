@@ -418,8 +418,8 @@ fn split_fans(
     // when both run the same way, at the other one otherwise.
     let next = |c: usize| c - c % 3 + (c % 3 + 1) % 3;
     let mut fans = UnionFind::new(3 * tris.len());
-    for k in 0..tris.len() {
-        for (i, across) in adjacency[k].iter().enumerate() {
+    for (k, sides) in adjacency.iter().enumerate() {
+        for (i, across) in sides.iter().enumerate() {
             if let Some((h, same)) = *across {
                 let (a, b) = (3 * k + i, next(3 * k + i));
                 let (c, d) = (h as usize, next(h as usize));
