@@ -22,15 +22,25 @@ fn main() {
         .0;
     let radius: f64 = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(0.01);
     let unit = Normalization::of(&input).apply(&input);
-    let field = MetricField::from_curvature(unit.clone(), &MetricOptions::default()).expect("m");
     let options = RemeshOptions {
         sweeps: std::env::var("SWEEPS")
             .ok()
             .and_then(|s| s.parse().ok())
             .unwrap_or(1),
-        feature_angle: std::env::var("FEATURE").ok().and_then(|s| s.parse().ok()),
+        features: std::env::var("FEATURE")
+            .ok()
+            .map(|s| conemesh::features::FeatureRule::parse(&s).expect("FEATURE"))
+            .unwrap_or_default(),
         ..RemeshOptions::default()
     };
+    let field = MetricField::from_curvature(
+        unit.clone(),
+        &MetricOptions {
+            features: options.features,
+            ..MetricOptions::default()
+        },
+    )
+    .expect("m");
     let res = remesh(&field, &Stages::default(), &options, |_| {}).expect("run");
     let out = &res.mesh;
     let metrics: Vec<_> = out.positions.iter().map(|p| field.eval(p)).collect();
@@ -112,15 +122,11 @@ fn main() {
         corner_pos.contains(&b)
     };
     // Output vertices on a feature line (`FEATURE` degrees): located on a sharp input edge.
-    let sharp: std::collections::HashSet<EdgeKey> = match options.feature_angle {
-        Some(a) => {
-            let topo = conemesh::Topology::build(&unit);
-            conemesh::features::sharp_edges(&unit, &topo, a)
-                .into_iter()
-                .collect()
-        }
-        None => Default::default(),
-    };
+    let sharp: std::collections::HashSet<EdgeKey> = options
+        .features
+        .edges(&unit, &conemesh::Topology::build(&unit))
+        .into_iter()
+        .collect();
     let on_feature = |v: conemesh::VertexId| {
         let l = res.locations[v.idx()];
         let t = unit.triangles[l.face.idx()];

@@ -46,6 +46,199 @@ impl FeatureLines {
     }
 }
 
+/// Which input edges are feature lines.
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FeatureRule {
+    /// None (the default, the paper).
+    #[default]
+    Off,
+    /// Every interior edge whose faces' normals differ by more than this many degrees
+    /// (`--feature-angle DEG`).
+    Angle(f64),
+    /// [`auto_feature_edges`]: edges sharper than [`AUTO_ANGLE`] that stand out from their
+    /// faces' other edges and form crease lines. Not the default: on organic meshes it still
+    /// picks edges (paper-notes "Feature lines").
+    Auto,
+}
+
+impl FeatureRule {
+    /// The feature edges of `mesh` under this rule, sorted.
+    pub fn edges(&self, mesh: &TriMesh, topo: &Topology) -> Vec<EdgeKey> {
+        match *self {
+            FeatureRule::Off => Vec::new(),
+            FeatureRule::Angle(a) => sharp_edges(mesh, topo, a),
+            FeatureRule::Auto => auto_feature_edges(mesh, topo),
+        }
+    }
+
+    /// Reads `auto`, `off` (or `0`) or an angle in degrees, as `--feature-angle` takes it.
+    pub fn parse(s: &str) -> Result<FeatureRule, String> {
+        match s.trim() {
+            "auto" => Ok(FeatureRule::Auto),
+            "off" => Ok(FeatureRule::Off),
+            t => {
+                let a: f64 = t
+                    .parse()
+                    .map_err(|_| format!("expected auto, off or an angle in degrees, got {t:?}"))?;
+                let rule = match a == 0.0 {
+                    true => FeatureRule::Off,
+                    false => FeatureRule::Angle(a),
+                };
+                rule.validate()?;
+                Ok(rule)
+            }
+        }
+    }
+
+    /// Checks the angle (in (0, 180) degrees).
+    pub fn validate(&self) -> Result<(), String> {
+        match *self {
+            FeatureRule::Angle(a) if !(a > 0.0 && a < 180.0) => Err(format!(
+                "feature angle must be between 0 and 180 degrees (exclusive), got {a}"
+            )),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The dihedral threshold of [`FeatureRule::Auto`], degrees between the faces' normals.
+pub const AUTO_ANGLE: f64 = 40.0;
+
+/// Largest turn (degrees) between consecutive edges of one crease line in
+/// [`auto_feature_edges`].
+pub const AUTO_MAX_TURN: f64 = 60.0;
+
+/// Fewest edges of a crease line that neither closes nor joins other lines at both ends.
+pub const AUTO_MIN_EDGES: usize = 3;
+
+/// [`FeatureRule::Auto`]: the edges sharper than [`AUTO_ANGLE`], grouped into lines (chains of
+/// sharp edges through vertices where exactly two meet and the line turns by at most
+/// [`AUTO_MAX_TURN`]); a line is kept when it is closed, or joins other sharp edges at both
+/// ends (a CAD edge from corner to corner, however short), or has at least
+/// [`AUTO_MIN_EDGES`] edges. What is dropped are short open runs of sharp edges: the isolated
+/// spikes and folds of a scan or of a coarse organic mesh.
+pub fn auto_feature_edges(mesh: &TriMesh, topo: &Topology) -> Vec<EdgeKey> {
+    let sharp = contrasted(mesh, topo, sharp_edges(mesh, topo, AUTO_ANGLE));
+    if sharp.is_empty() {
+        return sharp;
+    }
+    let mut at: HashMap<VertexId, Vec<usize>> = HashMap::new();
+    for (i, e) in sharp.iter().enumerate() {
+        at.entry(e.0).or_default().push(i);
+        at.entry(e.1).or_default().push(i);
+    }
+    let cos_turn = AUTO_MAX_TURN.to_radians().cos();
+    let dir = |i: usize, from: VertexId| {
+        let e = sharp[i];
+        let to = if e.0 == from { e.1 } else { e.0 };
+        (mesh.positions[to.idx()] - mesh.positions[from.idx()]).normalize()
+    };
+    // A line passes through v when exactly two sharp edges meet there and they continue each
+    // other (the second leaves v roughly opposite to where the first arrives).
+    let passes = |v: VertexId| -> Option<(usize, usize)> {
+        let es = at.get(&v)?;
+        if es.len() != 2 {
+            return None;
+        }
+        let (a, b) = (dir(es[0], v), dir(es[1], v));
+        (-a.dot(&b) >= cos_turn).then_some((es[0], es[1]))
+    };
+    let mut line_of = vec![usize::MAX; sharp.len()];
+    let mut keep = vec![false; sharp.len()];
+    for start in 0..sharp.len() {
+        if line_of[start] != usize::MAX {
+            continue;
+        }
+        // Walk both ways from `start` through vertices the line passes.
+        let mut members = vec![start];
+        line_of[start] = start;
+        let mut closed = false;
+        let mut ends_joined = 0;
+        for end in [sharp[start].0, sharp[start].1] {
+            let (mut v, mut e) = (end, start);
+            loop {
+                match passes(v) {
+                    Some((x, y)) => {
+                        let next = if x == e { y } else { x };
+                        if line_of[next] == start {
+                            closed = true;
+                            break;
+                        }
+                        line_of[next] = start;
+                        members.push(next);
+                        let k = sharp[next];
+                        v = if k.0 == v { k.1 } else { k.0 };
+                        e = next;
+                    }
+                    None => {
+                        // An end: joined when other sharp edges meet here.
+                        if at.get(&v).map_or(0, |x| x.len()) >= 2 {
+                            ends_joined += 1;
+                        }
+                        break;
+                    }
+                }
+            }
+            if closed {
+                break;
+            }
+        }
+        if closed || ends_joined == 2 || members.len() >= AUTO_MIN_EDGES {
+            for m in members {
+                keep[m] = true;
+            }
+        }
+    }
+    sharp
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(e, k)| k.then_some(e))
+        .collect()
+}
+
+/// How many times sharper than the other edges of its two faces a crease of
+/// [`auto_feature_edges`] is (the other edges' angles between normals, not counting other
+/// sharp edges): a CAD crease runs between faces that are smooth on each side; a sharp edge
+/// of a scan or a coarse organic mesh sits among other rough edges.
+pub const AUTO_CONTRAST: f64 = 2.0;
+
+/// The edges of `sharp` whose angle is at least [`AUTO_CONTRAST`] × the largest angle of the
+/// other, not sharp, edges of their two faces.
+fn contrasted(mesh: &TriMesh, topo: &Topology, sharp: Vec<EdgeKey>) -> Vec<EdgeKey> {
+    let set: HashSet<EdgeKey> = sharp.iter().copied().collect();
+    let angle = |f: FaceId, g: FaceId| {
+        let (n1, n2) = (mesh.face_normal(f), mesh.face_normal(g));
+        n1.dot(&n2).clamp(-1.0, 1.0).acos()
+    };
+    // Largest angle of a non-sharp edge of each face.
+    let rough = |f: FaceId| {
+        let t = mesh.face(f);
+        (0..3)
+            .filter(|&i| !set.contains(&EdgeKey::new(t[i], t[(i + 1) % 3])))
+            .filter_map(|i| topo.neighbor(f, i).map(|g| angle(f, g)))
+            .fold(0.0f64, f64::max)
+    };
+    let mut face_of: HashMap<EdgeKey, (FaceId, FaceId)> = HashMap::new();
+    for f in mesh.faces() {
+        let t = mesh.face(f);
+        for i in 0..3 {
+            let e = EdgeKey::new(t[i], t[(i + 1) % 3]);
+            if let (true, Some(g)) = (set.contains(&e), topo.neighbor(f, i)) {
+                face_of.insert(e, (f, g));
+            }
+        }
+    }
+    sharp
+        .into_iter()
+        .filter(|e| {
+            face_of
+                .get(e)
+                .is_some_and(|&(f, g)| angle(f, g) >= AUTO_CONTRAST * rough(f).max(rough(g)))
+        })
+        .collect()
+}
+
 /// Interior edges of `mesh` whose two faces' unit normals make an angle larger than
 /// `angle_deg` degrees, sorted. Edges of zero-area faces are skipped (no normal).
 pub fn sharp_edges(mesh: &TriMesh, topo: &Topology, angle_deg: f64) -> Vec<EdgeKey> {
@@ -227,21 +420,18 @@ pub enum FeatureError {
     },
 }
 
-/// The feature lines of Algorithm 1's working mesh (before the loop): the input edges sharper
-/// than `angle_deg` (`None`: no feature lines), each split into pieces of about `l_tar` in
-/// `metrics` (the metric the planar remesher sees, one tensor per reference vertex).
+/// The feature lines of Algorithm 1's working mesh (before the loop): the input edges `rule`
+/// picks, each split into pieces of about `l_tar` in `metrics` (the metric the planar
+/// remesher sees, one tensor per reference vertex).
 pub fn split_to_target(
     work: &mut WorkingMesh,
     reference: &TriMesh,
     topo: &Topology,
-    angle_deg: Option<f64>,
+    rule: FeatureRule,
     metrics: &[nalgebra::Matrix3<f64>],
     l_tar: f64,
 ) -> Result<FeatureLines, FeatureError> {
-    let sharp = match angle_deg {
-        Some(a) => sharp_edges(reference, topo, a),
-        None => Vec::new(),
-    };
+    let sharp = rule.edges(reference, topo);
     if sharp.is_empty() {
         return Ok(FeatureLines::default());
     }
@@ -304,6 +494,21 @@ mod tests {
         // A smooth sphere has none at 30°.
         let s = generators::icosphere(1.0, 3);
         assert!(sharp_edges(&s, &Topology::build(&s), 30.0).is_empty());
+    }
+
+    /// The auto rule keeps a subdivided cube's 12 edges (sharp, between flat sides) and finds
+    /// nothing on a smooth sphere; the flag's values parse.
+    #[test]
+    fn auto_rule_keeps_cad_creases_and_skips_smooth_surfaces() {
+        let cube = generators::cube(3);
+        let topo = Topology::build(&cube);
+        assert_eq!(FeatureRule::Auto.edges(&cube, &topo).len(), 12 * 3);
+        let s = generators::icosphere(1.0, 3);
+        assert!(FeatureRule::Auto.edges(&s, &Topology::build(&s)).is_empty());
+        assert_eq!(FeatureRule::parse("auto"), Ok(FeatureRule::Auto));
+        assert_eq!(FeatureRule::parse("0"), Ok(FeatureRule::Off));
+        assert_eq!(FeatureRule::parse("30"), Ok(FeatureRule::Angle(30.0)));
+        assert!(FeatureRule::parse("-5").is_err() && FeatureRule::parse("x").is_err());
     }
 
     /// Splitting keeps an oriented manifold of the same topology and area; every new vertex

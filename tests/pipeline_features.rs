@@ -1,4 +1,4 @@
-//! Feature lines (`RemeshOptions::feature_angle`, `conemesh::features`, paper-notes
+//! Feature lines (`RemeshOptions::features`, `conemesh::features`, paper-notes
 //! "Feature lines"): input edges sharper than the angle are split to the target length and
 //! come out as output edges, exactly on the input's crease, certified by the run; a bad
 //! angle is refused by name. Release only for the shared mesh (fandisk).
@@ -50,7 +50,7 @@ fn the_lens_equator_is_an_output_polyline_exactly_on_the_crease() {
     let samples = crease_samples(&m, 60.0);
     assert_eq!(samples.len(), 40 * 7);
     let with = RemeshOptions {
-        feature_angle: Some(60.0),
+        features: conemesh::features::FeatureRule::Angle(60.0),
         ..RemeshOptions::default()
     };
     let on = remesh(&f, &Stages::default(), &with, |_| {}).expect("run with feature lines");
@@ -85,7 +85,7 @@ fn a_bad_feature_angle_is_refused() {
     let f = field(&m);
     for bad in [f64::NAN, 0.0, -10.0, 180.0, 270.0, f64::INFINITY] {
         let o = RemeshOptions {
-            feature_angle: Some(bad),
+            features: conemesh::features::FeatureRule::Angle(bad),
             ..RemeshOptions::default()
         };
         match remesh(&f, &Stages::default(), &o, |_| {}) {
@@ -117,7 +117,7 @@ fn fandisk_keeps_its_sharp_edges() {
     let unit = norm.apply(&file_mesh);
     let f = field(&unit);
     let o = RemeshOptions {
-        feature_angle: Some(60.0),
+        features: conemesh::features::FeatureRule::Angle(60.0),
         ..RemeshOptions::default()
     };
     let r = remesh(&f, &Stages::default(), &o, |_| {}).expect("fandisk with feature lines");
@@ -171,7 +171,7 @@ fn cli_feature_angle_is_reported_and_checked() {
     let r: serde_json::Value =
         serde_json::from_slice(&std::fs::read(report).expect("report")).expect("JSON");
     assert_eq!(r["run"]["feature_edges"], 40);
-    assert_eq!(r["run"]["options"]["feature_angle"], 60.0);
+    assert_eq!(r["run"]["options"]["features"]["angle"], 60.0);
     let (o, out, _) = run("200", "bad");
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("feature angle"));
@@ -211,7 +211,7 @@ fn a_strategy_that_crosses_a_feature_line_is_stopped_by_name() {
         ..Stages::default()
     };
     let o = RemeshOptions {
-        feature_angle: Some(60.0),
+        features: conemesh::features::FeatureRule::Angle(60.0),
         ..RemeshOptions::default()
     };
     match remesh(&f, &stages, &o, |_| {}) {
@@ -229,7 +229,7 @@ fn a_strategy_that_crosses_a_feature_line_is_stopped_by_name() {
 fn a_tiny_target_with_feature_lines_is_an_input_error() {
     let f = field(&lens());
     let o = RemeshOptions {
-        feature_angle: Some(60.0),
+        features: conemesh::features::FeatureRule::Angle(60.0),
         target: conemesh::quality::TargetLength::Absolute(1e-20),
         ..RemeshOptions::default()
     };

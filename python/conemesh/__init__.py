@@ -203,7 +203,8 @@ def remesh(V, F, metric=None, **options):
         length), ``ltar=None`` (absolute target), ``seed=1``, ``strategy="cone"``,
         ``strategy_opt=None`` (a mapping ``{"rings": 4}`` or a list of ``"KEY=VALUE"``),
         ``param="sd"``, ``remesher="lct"``, ``hausd=0.0035``, ``sweeps=1``,
-        ``corner_defect=1.0``, ``feature_angle=0.0``, ``coarse="auto"``, ``hmin``,
+        ``corner_defect=1.0``, ``feature_angle="off"`` (or ``"auto"``, or degrees),
+        ``crease_metric=False``, ``coarse="auto"``, ``hmin``,
         ``hmax``, ``hgrad`` (``None``), ``keep_boundary=False``,
         ``boundary_corner_angle=45.0``, ``improvers=None`` (``"surface,eq5"``; a list is
         joined), ``no_improve=False``, ``max_patches=None``, ``no_self_intersections=False``,

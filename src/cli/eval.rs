@@ -24,6 +24,14 @@ pub struct EvalArgs {
     /// Per-input-vertex metric tensors (Medit .sol, file units) instead of the curvature metric.
     #[arg(long, value_name = "M.sol")]
     pub metric: Option<PathBuf>,
+    /// Fit the curvature metric on each side of the feature lines that `--feature-angle`
+    /// picks (as `remesh --crease-metric`) instead of across them.
+    #[arg(long)]
+    pub crease_metric: bool,
+    /// The feature lines of `--crease-metric` (as `remesh --feature-angle`: `auto`, an angle in
+    /// degrees, or `off`).
+    #[arg(long, default_value = "auto", value_parser = conemesh::features::FeatureRule::parse)]
+    pub feature_angle: conemesh::features::FeatureRule,
     /// Write the full report as JSON.
     #[arg(long, value_name = "R.json")]
     pub json: Option<PathBuf>,
@@ -91,6 +99,13 @@ pub fn run(args: EvalArgs) -> anyhow::Result<ExitCode> {
         samples: args.samples,
         seed: args.seed,
         self_intersections: !args.no_self_intersections,
+        metric: conemesh::metric::MetricOptions {
+            features: match args.crease_metric {
+                true => args.feature_angle,
+                false => conemesh::features::FeatureRule::Off,
+            },
+            ..Default::default()
+        },
         ..EvalOptions::default()
     };
     let report = evaluate(&input, &output, metric.as_deref(), &opts)

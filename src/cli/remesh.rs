@@ -5,6 +5,7 @@
 //! with these clap definitions and cannot drift from the CLI's defaults.
 
 use anyhow::Context;
+use conemesh::features::FeatureRule;
 use conemesh::pipeline::{CoarseInput, Progress, RemeshOptions, Remesher, Stages};
 use conemesh::quality::{EvalOptions, EvalReport, TargetLength};
 use conemesh::registry::Params;
@@ -129,11 +130,17 @@ pub struct RemeshArgs {
     /// (tips, cone points, corners) as output vertices. 0 keeps none (the paper).
     #[arg(long, default_value_t = 1.0)]
     pub corner_defect: f64,
-    /// Keep input edges whose two faces' normals differ by more than this many degrees as
-    /// feature lines: split to the target length and kept as output edges. 0 keeps none
-    /// (the paper).
-    #[arg(long, default_value_t = 0.0)]
-    pub feature_angle: f64,
+    /// Feature lines, kept as output edges (split to the target length) with the curvature
+    /// `off` (or 0: none, the paper), an angle in degrees (every edge sharper than that), or
+    /// `auto` (crease lines of edges sharper than 40° that stand out from their faces' other
+    /// edges).
+    #[arg(long, default_value = "off", value_parser = FeatureRule::parse)]
+    pub feature_angle: FeatureRule,
+    /// Fit the curvature metric on each side of the feature lines instead of across them
+    /// (paper-notes "Feature lines"); score with `eval --crease-metric` and the same
+    /// `--feature-angle`.
+    #[arg(long)]
+    pub crease_metric: bool,
     /// The coarse-input profile (3 sweeps, finer fidelity control; paper-notes "Coarse
     /// inputs"): `auto` runs it when the distance tolerance rather than the metric sets the
     /// output's size (the a-priori fidelity scaling at least doubles the expected face count;
@@ -487,7 +494,8 @@ pub fn options(args: &RemeshArgs) -> RemeshOptions {
         sweeps: args.sweeps,
         batch: args.batch,
         corner_defect: (args.corner_defect != 0.0).then_some(args.corner_defect),
-        feature_angle: (args.feature_angle != 0.0).then_some(args.feature_angle),
+        features: args.feature_angle,
+        crease_metric: args.crease_metric,
         sizes: conemesh::metric::SizeOptions {
             hmin: args.hmin,
             hmax: args.hmax,

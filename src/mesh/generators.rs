@@ -172,6 +172,57 @@ pub fn plate(size: f64, cells: usize) -> TriMesh {
     })
 }
 
+/// The surface of the unit cube `[0, 1]³`, each side a `cells`×`cells` grid of squares split
+/// into two triangles: closed, genus 0, with 12 sharp edges (90° between the normals) and 8
+/// corners. For feature-line tests.
+pub fn cube(cells: usize) -> TriMesh {
+    let n = cells.max(1);
+    let mut index: HashMap<[usize; 3], usize> = HashMap::new();
+    let mut positions = Vec::new();
+    let mut tris = Vec::new();
+    let mut vertex = |c: [usize; 3], positions: &mut Vec<Point3<f64>>| {
+        *index.entry(c).or_insert_with(|| {
+            positions.push(Point3::new(
+                c[0] as f64 / n as f64,
+                c[1] as f64 / n as f64,
+                c[2] as f64 / n as f64,
+            ));
+            positions.len() - 1
+        })
+    };
+    // Side (axis, at 0 or n): the grid runs over the two other axes.
+    for axis in 0..3 {
+        for high in [false, true] {
+            let (a1, a2) = ((axis + 1) % 3, (axis + 2) % 3);
+            for i in 0..n {
+                for j in 0..n {
+                    let mut corner = |di: usize, dj: usize| {
+                        let mut c = [0; 3];
+                        c[axis] = if high { n } else { 0 };
+                        c[a1] = i + di;
+                        c[a2] = j + dj;
+                        vertex(c, &mut positions)
+                    };
+                    let (p00, p10, p11, p01) =
+                        (corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1));
+                    // (a1, a2, axis) is right-handed: counter-clockwise in (a1, a2) faces +axis.
+                    match high {
+                        true => {
+                            tris.push([p00, p10, p11]);
+                            tris.push([p00, p11, p01]);
+                        }
+                        false => {
+                            tris.push([p00, p11, p10]);
+                            tris.push([p00, p01, p11]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    build(positions, tris)
+}
+
 /// Piece of a cylinder of radius `r` over the angle range `[0, angle]` and height `h`
 /// (a developable disk).
 pub fn cylinder_piece(r: f64, angle: f64, h: f64, nu: usize, nv: usize) -> TriMesh {

@@ -70,7 +70,7 @@ const FACING_MIN_COS: f64 = 1e-9;
 
 /// Minimum number of neighbours (besides the vertex) for a fit; libigl asks for 6 points
 /// including the vertex itself.
-const MIN_NEIGHBOURS: usize = 5;
+pub(super) const MIN_NEIGHBOURS: usize = 5;
 
 /// A deterministic orthonormal tangent pair `(t1, t2)` with `t1 × t2 = n` for a unit normal
 /// `n`: `t1` is the coordinate axis least aligned with `n` (lowest index on ties), projected.
@@ -201,15 +201,15 @@ impl Scratch {
 }
 
 /// Fit at one vertex; `ring` excludes the vertex itself.
-fn fit_vertex(
+/// `n0` is the frame normal: the vertex's own area-weighted normal (libigl's default,
+/// `localMode` with `AVERAGE` normals), or one side's normal at a crease ([`super::creases`]).
+pub(super) fn fit_vertex(
     positions: &[nalgebra::Point3<f64>],
     normals: &[Vector3<f64>],
+    n0: Vector3<f64>,
     v: usize,
     ring: &[u32],
 ) -> PrincipalCurvature {
-    // Frame normal: the vertex's own area-weighted normal (libigl's default, `localMode` with
-    // `AVERAGE` normals).
-    let n0 = normals[v];
     if !n0.norm().is_finite() || n0.norm() <= 0.0 || ring.len() < MIN_NEIGHBOURS {
         return planar(n0);
     }
@@ -352,7 +352,7 @@ pub fn principal_curvatures(
             || Scratch::new(n),
             |s, v| {
                 s.k_ring(&adj, v, radius);
-                fit_vertex(&mesh.positions, &normals, v, &s.ring)
+                fit_vertex(&mesh.positions, &normals, normals[v], v, &s.ring)
             },
         )
         .collect();

@@ -9,6 +9,7 @@
 //!
 //! User-supplied metrics come from Medit `.sol` files ([`crate::io::sol`]).
 
+pub mod creases;
 pub mod curvature;
 pub mod field;
 pub mod normalize;
@@ -21,6 +22,7 @@ pub use normalize::Normalization;
 pub use sizes::{apply_sizes, SizeOptions};
 pub use unit_target::unit_target_metric;
 
+use crate::features::FeatureRule;
 use crate::mesh::{MeshError, TriMesh};
 use nalgebra::Matrix3;
 use thiserror::Error;
@@ -70,6 +72,12 @@ pub struct MetricOptions {
     /// Lower bound on |k₁|, |k₂| (default `1e-4`, the paper's value, "to prevent the long
     /// edge length caused by too small curvature"); in unit-space units (1/bbox diagonal).
     pub floor: f64,
+    /// The feature lines the curvature is fitted around ([`creases`]): each side of a crease
+    /// gets its own curvature. Default [`FeatureRule::Off`]: the paper's and libigl's fit
+    /// across creases, the yardstick of `PEERS.md`. [`crate::pipeline::Remesher`] sets it to
+    /// [`crate::pipeline::RemeshOptions::features`] when
+    /// [`crate::pipeline::RemeshOptions::crease_metric`] is on.
+    pub features: FeatureRule,
 }
 
 impl Default for MetricOptions {
@@ -77,6 +85,7 @@ impl Default for MetricOptions {
         MetricOptions {
             curvature: CurvatureOptions::default(),
             floor: 1e-4,
+            features: FeatureRule::Off,
         }
     }
 }
@@ -93,7 +102,8 @@ pub fn metric_from_curvature(pc: &PrincipalCurvature, floor: f64) -> Matrix3<f64
 }
 
 /// The curvature metric (Sec. 4.1) at every vertex of `mesh`, from
-/// [`principal_curvatures`] and [`metric_from_curvature`].
+/// [`principal_curvatures`] and [`metric_from_curvature`]; fitted around the feature lines of
+/// `opts.features` where there are any ([`creases`]).
 ///
 /// Expects the **unit-space** mesh (bounding-box diagonal 1, see [`Normalization`]): the floor
 /// is in 1/(unit length). Convert the result to file units with
@@ -102,6 +112,20 @@ pub fn curvature_metric(
     mesh: &TriMesh,
     opts: &MetricOptions,
 ) -> Result<Vec<Matrix3<f64>>, MetricError> {
+    mesh.validate()?;
+    let feature: std::collections::HashSet<_> = opts
+        .features
+        .edges(mesh, &crate::mesh::Topology::build(mesh))
+        .into_iter()
+        .collect();
+    if !feature.is_empty() {
+        return Ok(creases::crease_aware_metric(
+            mesh,
+            &opts.curvature,
+            opts.floor,
+            &feature,
+        ));
+    }
     let pcs = principal_curvatures(mesh, &opts.curvature)?;
     Ok(pcs
         .iter()

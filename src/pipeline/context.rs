@@ -223,7 +223,7 @@ impl LoopState {
             &mut work,
             reference,
             &ctx.reference_topology,
-            ctx.plan.options.feature_angle,
+            ctx.plan.options.features,
             ctx.field().vertex_metrics(),
             ctx.plan.l_tar,
         )

@@ -185,7 +185,7 @@ pub enum PipelineError {
     /// output at its input position.
     #[error("final mesh: the input's corner vertex {0} was removed or moved")]
     CornerLost(VertexId),
-    /// A piece of a feature line ([`super::RemeshOptions::feature_angle`]) is not an edge of
+    /// A piece of a feature line ([`super::RemeshOptions::features`]) is not an edge of
     /// the output, or one of its vertices moved.
     #[error("final mesh: the feature-line edge {0} was removed or moved")]
     FeatureLost(EdgeKey),

@@ -1,6 +1,7 @@
 //! Options of Algorithm 1 and the research extension points it runs.
 
 use crate::boundary::BoundaryOptions;
+use crate::features::FeatureRule;
 use crate::fidelity::FidelityOptions;
 use crate::improve::Improver;
 use crate::metric::SizeOptions;
@@ -56,11 +57,15 @@ pub struct RemeshOptions {
     /// patch contains them in its interior and the relocation pass does not move them.
     /// `None` keeps no vertex (the paper). Default `Some(1.0)`.
     pub corner_defect: Option<f64>,
-    /// Feature lines (our addition, [`crate::features`]): input edges whose faces' normals
-    /// differ by more than this many degrees are split to the target length and kept as
-    /// edges of the output (no patch crosses them, no pass moves or flips them). `None`
-    /// keeps none (the paper). Default `None`.
-    pub feature_angle: Option<f64>,
+    /// Feature lines (our addition, [`crate::features`]): the input edges this rule picks are
+    /// split to the target length and kept as edges of the output (no patch crosses them, no
+    /// pass moves or flips them). Default [`FeatureRule::Off`] (the paper): [`FeatureRule::Auto`]
+    /// still finds sharp edges on organic meshes (paper-notes "Feature lines").
+    pub features: FeatureRule,
+    /// Fit the curvature metric on each side of the feature lines ([`crate::metric::creases`])
+    /// instead of across them (the paper's fit). [`super::Remesher`] reads it when it computes
+    /// the curvature metric; [`super::remesh`] takes the field as given. Default off.
+    pub crease_metric: bool,
     /// Bounds and gradation of the metric's sizes ([`crate::metric::sizes`]), in the units of
     /// the field given to [`super::remesh`] ([`super::Remesher`] takes them in file units).
     /// All off by default.
@@ -160,7 +165,8 @@ impl Default for RemeshOptions {
             sweeps: 1,
             corner_pullback: false,
             corner_defect: Some(1.0),
-            feature_angle: None,
+            features: FeatureRule::Off,
+            crease_metric: false,
             coarse_input: CoarseInput::Auto,
             boundary: BoundaryOptions::default(),
             sizes: SizeOptions::default(),
@@ -219,13 +225,7 @@ impl RemeshOptions {
                 "boundary corner angle must be in (0, 180] degrees, got {b}"
             ));
         }
-        if let Some(a) = self.feature_angle {
-            if !(a.is_finite() && a > 0.0 && a < 180.0) {
-                return Err(format!(
-                    "feature angle must be between 0 and 180 degrees, got {a}"
-                ));
-            }
-        }
+        self.features.validate()?;
         Ok(())
     }
 }

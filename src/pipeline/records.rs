@@ -467,7 +467,7 @@ pub struct RemeshReport {
     /// Input vertices kept as corners ([`RemeshOptions::corner_defect`]); each is certified
     /// to be a vertex of the output at its input position.
     pub corners: usize,
-    /// Input edges kept as feature lines ([`RemeshOptions::feature_angle`]).
+    /// Input edges kept as feature lines ([`RemeshOptions::features`]).
     pub feature_edges: usize,
     /// The pieces they were split into; each is certified to be an edge of the output, its
     /// vertices where the split put them.

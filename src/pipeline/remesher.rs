@@ -160,7 +160,16 @@ impl Remesher {
                 MetricField::from_surface_tensors(reference, unit)
                     .map_err(|e| in_file_numbering(e, &map))?
             }
-            None => MetricField::from_curvature(reference, &self.metric)?,
+            None => {
+                let opts = match self.options.crease_metric {
+                    true => MetricOptions {
+                        features: self.options.features,
+                        ..self.metric
+                    },
+                    false => self.metric,
+                };
+                MetricField::from_curvature(reference, &opts)?
+            }
         };
         // The size controls are given in file units; the run is in unit space.
         let mut options = self.options.clone();
