@@ -216,17 +216,22 @@ fn remesh_options(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
             .get_default_values()
             .first()
             .map(|s| s.to_string_lossy().into_owned());
-        d.set_item("default", default)?;
+        d.set_item("default", default.clone())?;
         let choices: Vec<String> = a
             .get_possible_values()
             .iter()
             .map(|p| p.get_name().to_string())
             .collect();
         // The value's type, asked of the option's own parser: a probe value it accepts.
+        // A default that is not a number (`--feature-angle off`, which also takes degrees)
+        // makes it a string option.
         let accepts = |v: &str| parse_args(&[format!("--{long}={v}")]).is_ok();
+        let word_default = default
+            .as_deref()
+            .is_some_and(|d| d.parse::<f64>().is_err());
         let ty = match kind {
             "flag" => "bool",
-            _ if !choices.is_empty() || accepts("x") => "str",
+            _ if !choices.is_empty() || accepts("x") || word_default => "str",
             _ if accepts("1") && !accepts("0.5") => "int",
             _ => "float",
         };

@@ -106,7 +106,6 @@ pub fn run(args: EvalArgs) -> anyhow::Result<ExitCode> {
             },
             ..Default::default()
         },
-        ..EvalOptions::default()
     };
     let report = evaluate(&input, &output, metric.as_deref(), &opts)
         .with_context(|| format!("evaluating {}", args.output.display()))?;

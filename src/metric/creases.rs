@@ -272,13 +272,16 @@ fn isotropic(sides: &[Side]) -> Matrix3<f64> {
 fn two_sided(s1: &Side, s2: &Side) -> Option<Matrix3<f64>> {
     let (n1, n2) = (s1.pc.normal, s2.pc.normal);
     let t = n1.cross(&n2);
-    if !(t.norm() > 0.0) {
+    // NaN normals fail as well as parallel ones.
+    if t.norm().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let t = t.normalize();
     let (u1, u2) = (n1.cross(&t).normalize(), n2.cross(&t).normalize());
     let basis = Matrix3::from_columns(&[t, u1, u2]);
-    if !(basis.determinant().abs() >= MIN_SIDE_SINE) {
+    if basis.determinant().abs().partial_cmp(&MIN_SIDE_SINE) == Some(std::cmp::Ordering::Less)
+        || basis.determinant().is_nan()
+    {
         return None;
     }
     let (m1, m2) = (&s1.metric, &s2.metric);
