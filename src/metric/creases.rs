@@ -253,14 +253,11 @@ fn combine(sides: &[Side], floor: f64) -> Matrix3<f64> {
 
 /// The isotropic tensor of the largest eigenvalue over `sides`.
 fn isotropic(sides: &[Side]) -> Matrix3<f64> {
-    let l = sides
-        .iter()
-        .map(|s| s.pc.k1.abs().max(s.pc.k2.abs()))
-        .fold(0.0f64, f64::max);
+    // A side's largest eigenvalue is max(|k₁|, |k₂|, floor).
     let l = sides
         .iter()
         .map(|s| s.metric.symmetric_eigenvalues().max())
-        .fold(l, f64::max);
+        .fold(0.0f64, f64::max);
     Matrix3::identity() * l
 }
 
@@ -279,9 +276,8 @@ fn two_sided(s1: &Side, s2: &Side) -> Option<Matrix3<f64>> {
     let t = t.normalize();
     let (u1, u2) = (n1.cross(&t).normalize(), n2.cross(&t).normalize());
     let basis = Matrix3::from_columns(&[t, u1, u2]);
-    if basis.determinant().abs().partial_cmp(&MIN_SIDE_SINE) == Some(std::cmp::Ordering::Less)
-        || basis.determinant().is_nan()
-    {
+    let det = basis.determinant().abs();
+    if det.is_nan() || det < MIN_SIDE_SINE {
         return None;
     }
     let (m1, m2) = (&s1.metric, &s2.metric);
