@@ -1,8 +1,9 @@
 //! The worst faces of a remesh, one by one: smallest angle and q in the metric, each corner's
 //! angle, whether its vertices are input corners (cone points kept by the corner rule) or on
 //! the boundary, and the edge lengths over L_tar. Diagnostics for Algorithm 2 (issue 18).
-//! `cargo run --release --example worst_faces -- MESH [N] [--no-improve] [--metric M.sol]`
-//! (with a metric: L_tar = 1, as `bench --suite analytic`).
+//! `cargo run --release --example worst_faces -- MESH [N] [--no-improve] [--metric M.sol]
+//! [--feature-angle RULE]` (with a metric: L_tar = 1, as `bench --suite analytic`). Vertex
+//! tags: C input corner, B boundary, F on an input feature edge.
 
 use conemesh::mesh::Topology;
 use conemesh::pipeline::{RemeshOptions, Remesher, Stages};
@@ -48,6 +49,7 @@ fn main() {
             Some(_) => conemesh::pipeline::TargetLength::Absolute(1.0),
             None => conemesh::pipeline::TargetLength::Factor(1.5),
         },
+        features: options_features(&a),
         ..RemeshOptions::default()
     };
     let out =
@@ -71,6 +73,11 @@ fn main() {
         .filter(|v| corners[v.idx()])
         .map(|v| *ref_mesh.position(v))
         .collect();
+    let feature_segments: Vec<_> = options_features(&a)
+        .edges(ref_mesh, &ref_topo)
+        .into_iter()
+        .map(|e| (*ref_mesh.position(e.0), *ref_mesh.position(e.1)))
+        .collect();
     let mesh = &unit.mesh;
     let topo = Topology::build(mesh);
     let metrics: Vec<_> = unit
@@ -89,9 +96,15 @@ fn main() {
             let p = mesh.position(v);
             let c = corner_pos.iter().any(|c| c == p);
             let b = topo.is_boundary_vertex(v);
-            match (c, b) {
-                (true, _) => "C",
-                (false, true) => "B",
+            let on_feature = feature_segments.iter().any(|(a, b)| {
+                let ab = b - a;
+                let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+                (p - (a + ab * t)).norm() < 1e-12
+            });
+            match (c, b, on_feature) {
+                (true, _, _) => "C",
+                (false, true, _) => "B",
+                (_, _, true) => "F",
                 _ => "-",
             }
         };
@@ -116,4 +129,12 @@ fn main() {
             unit.face_patch[f].map(|p| p.idx()),
         );
     }
+}
+
+fn options_features(a: &[String]) -> conemesh::features::FeatureRule {
+    a.iter()
+        .position(|s| s == "--feature-angle")
+        .and_then(|i| a.get(i + 1))
+        .map(|r| conemesh::features::FeatureRule::parse(r).expect("feature rule"))
+        .unwrap_or_default()
 }

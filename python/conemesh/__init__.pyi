@@ -55,7 +55,7 @@ def remesh(
     batch: int = 1,
     threads: int | None = None,
     corner_defect: float = 1.0,
-    feature_angle: float | Literal["auto", "off"] = "off",
+    feature_angle: float | Literal["auto", "off"] = "auto",
     crease_metric: bool = False,
     coarse: Literal["auto", "on", "off"] = "auto",
     hmin: float | None = None,

@@ -130,11 +130,11 @@ pub struct RemeshArgs {
     /// (tips, cone points, corners) as output vertices. 0 keeps none (the paper).
     #[arg(long, default_value_t = 1.0)]
     pub corner_defect: f64,
-    /// Feature lines, kept as output edges (split to the target length) with the curvature
-    /// `off` (or 0: none, the paper), an angle in degrees (every edge sharper than that), or
-    /// `auto` (crease lines of edges sharper than 40° that stand out from their faces' other
-    /// edges).
-    #[arg(long, default_value = "off", value_parser = FeatureRule::parse)]
+    /// Feature lines, kept as output edges (resampled to the metric, vertices exactly on the
+    /// input's creases): `auto` (long, smooth crease lines of edges sharper than 40° that stand
+    /// out from their faces' other edges), an angle in degrees (every edge sharper than that),
+    /// or `off` (or 0: none, the paper).
+    #[arg(long, default_value = "auto", value_parser = FeatureRule::parse)]
     pub feature_angle: FeatureRule,
     /// Fit the curvature metric on each side of the feature lines instead of across them
     /// (paper-notes "Feature lines"); score with `eval --crease-metric` and the same

@@ -223,6 +223,33 @@ pub fn cube(cells: usize) -> TriMesh {
     build(positions, tris)
 }
 
+/// A closed can as a CAD exporter tessellates one: a cylinder of radius `r` and height `h`
+/// around +z with `sectors` vertices per rim, its wall `bands` bands of long triangles, each
+/// flat cap a fan from its centre. Closed, genus 0, with two circular 90° creases. For
+/// feature-line tests (curved creases on a coarse part).
+pub fn can(r: f64, h: f64, sectors: usize, bands: usize) -> TriMesh {
+    let (n, b) = (sectors.max(3), bands.max(1));
+    let mut positions = vec![Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 0.0, h)];
+    for k in 0..=b {
+        let z = h * k as f64 / b as f64;
+        for i in 0..n {
+            let u = 2.0 * PI * i as f64 / n as f64;
+            positions.push(Point3::new(r * u.cos(), r * u.sin(), z));
+        }
+    }
+    let ring = |k: usize, i: usize| 2 + k * n + i % n;
+    let mut tris = Vec::with_capacity(2 * n * (b + 1));
+    for i in 0..n {
+        tris.push([0, ring(0, i + 1), ring(0, i)]);
+        tris.push([1, ring(b, i), ring(b, i + 1)]);
+        for k in 0..b {
+            tris.push([ring(k, i), ring(k, i + 1), ring(k + 1, i + 1)]);
+            tris.push([ring(k, i), ring(k + 1, i + 1), ring(k + 1, i)]);
+        }
+    }
+    build(positions, tris)
+}
+
 /// Piece of a cylinder of radius `r` over the angle range `[0, angle]` and height `h`
 /// (a developable disk).
 pub fn cylinder_piece(r: f64, angle: f64, h: f64, nu: usize, nv: usize) -> TriMesh {

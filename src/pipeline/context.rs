@@ -223,9 +223,11 @@ impl LoopState {
             &mut work,
             reference,
             &ctx.reference_topology,
-            ctx.plan.options.features,
+            &ctx.plan.feature_edges,
+            &ctx.corners,
             ctx.field().vertex_metrics(),
             ctx.plan.l_tar,
+            ctx.plan.options.fidelity.max_deviation,
         )
         .map_err(|e| PipelineError::Input(e.to_string()))?;
         let pinned = (0..work.mesh.n_vertices())
@@ -233,7 +235,7 @@ impl LoopState {
                 ctx.corners.get(v).copied().unwrap_or(false) || features.is_pinned(VertexId::new(v))
             })
             .collect();
-        let topo = match work.mesh.n_faces() == reference.n_faces() {
+        let topo = match features.edges.is_empty() {
             true => ctx.reference_topology.clone(),
             false => Topology::build(&work.mesh),
         };

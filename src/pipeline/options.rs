@@ -58,9 +58,10 @@ pub struct RemeshOptions {
     /// `None` keeps no vertex (the paper). Default `Some(1.0)`.
     pub corner_defect: Option<f64>,
     /// Feature lines (our addition, [`crate::features`]): the input edges this rule picks are
-    /// split to the target length and kept as edges of the output (no patch crosses them, no
-    /// pass moves or flips them). Default [`FeatureRule::Off`] (the paper): [`FeatureRule::Auto`]
-    /// still finds sharp edges on organic meshes (paper-notes "Feature lines").
+    /// resampled to the metric and kept as edges of the output (no patch crosses them, no
+    /// pass moves or flips them). Default [`FeatureRule::Auto`]: a CAD part's creases, few or
+    /// none of an organic mesh's edges; [`FeatureRule::Off`] is the paper (paper-notes
+    /// "Feature lines").
     pub features: FeatureRule,
     /// Fit the curvature metric on each side of the feature lines ([`crate::metric::creases`])
     /// instead of across them (the paper's fit). [`super::Remesher`] reads it when it computes
@@ -165,7 +166,7 @@ impl Default for RemeshOptions {
             sweeps: 1,
             corner_pullback: false,
             corner_defect: Some(1.0),
-            features: FeatureRule::Off,
+            features: FeatureRule::Auto,
             crease_metric: false,
             coarse_input: CoarseInput::Auto,
             boundary: BoundaryOptions::default(),

@@ -33,6 +33,8 @@ pub struct Plan {
     pub expected_fidelity: f64,
     /// The coarse-input profile runs.
     pub coarse: bool,
+    /// The input edges that are feature lines ([`crate::features::FeatureRule::edges`]).
+    pub feature_edges: Vec<crate::ids::EdgeKey>,
     /// The metric with the size controls applied ([`RemeshOptions::sizes`]), when they are on:
     /// the run's metric, for the remeshing and every measure.
     sized: Option<MetricField>,
@@ -122,6 +124,22 @@ impl Plan {
         } else {
             options.clone()
         };
+        // Curved feature lines refine the faces beside them (the a-priori scaling stops at
+        // creases), after the profile is chosen: a part's creases are no sign of a coarse input.
+        let feature_edges = options.features.edges(reference, topo);
+        if !fid_scale.is_empty() && !feature_edges.is_empty() {
+            let crease = crate::features::crease_scale(
+                reference,
+                &feature_edges,
+                field.vertex_metrics(),
+                l_tar,
+                options.fidelity.max_deviation,
+                min_edge,
+            );
+            for (f, c) in fid_scale.iter_mut().zip(crease) {
+                *f = f.max(c);
+            }
+        }
         let scaled = if fid_scale.is_empty() {
             None
         } else {
@@ -146,6 +164,7 @@ impl Plan {
             expected,
             expected_fidelity,
             coarse,
+            feature_edges,
             sized,
             scaled,
         })

@@ -21,6 +21,9 @@ use crate::stitch::WorkingMesh;
 use nalgebra::Point3;
 use std::collections::{HashMap, HashSet};
 
+mod resample;
+pub use resample::{crease_scale, feature_chains, resample_feature_lines, NODE_TURN, SNAP};
+
 /// Most vertices a feature split may add (a target far below the feature edges' length
 /// would otherwise ask for an unbounded allocation).
 pub const MAX_NEW_VERTICES: usize = 10_000_000;
@@ -50,15 +53,15 @@ impl FeatureLines {
 #[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FeatureRule {
-    /// None (the default, the paper).
-    #[default]
+    /// None (the paper).
     Off,
     /// Every interior edge whose faces' normals differ by more than this many degrees
     /// (`--feature-angle DEG`).
     Angle(f64),
-    /// [`auto_feature_edges`]: edges sharper than [`AUTO_ANGLE`] that stand out from their
-    /// faces' other edges and form crease lines. Not the default: on organic meshes it still
-    /// picks edges (paper-notes "Feature lines").
+    /// [`auto_feature_edges`] (the default): edges sharper than [`AUTO_ANGLE`] that stand out
+    /// from their faces' other edges and form long, smooth crease lines; a CAD part's creases,
+    /// few or none of an organic mesh's edges (paper-notes "Feature lines").
+    #[default]
     Auto,
 }
 
@@ -190,11 +193,76 @@ pub fn auto_feature_edges(mesh: &TriMesh, topo: &Topology) -> Vec<EdgeKey> {
             }
         }
     }
-    sharp
+    let lines: Vec<EdgeKey> = sharp
         .into_iter()
         .zip(keep)
         .filter_map(|(e, k)| k.then_some(e))
-        .collect()
+        .collect();
+    smooth_chains(mesh, topo, lines)
+}
+
+/// A chain (between nodes, [`feature_chains`]) with more edges than this is long for
+/// [`smooth_chains`].
+pub const AUTO_CHAIN_EDGES: usize = 4;
+
+/// A chain at least this long (fraction of the bounding-box diagonal) is long for
+/// [`smooth_chains`], whatever its edge count.
+pub const AUTO_CHAIN_LENGTH: f64 = 0.1;
+
+/// Largest turn (degrees) between consecutive edges of a chain [`smooth_chains`] keeps.
+pub const AUTO_CHAIN_TURN: f64 = 30.0;
+
+/// The chains of `lines` that look like a CAD part's creases: smooth (every turn at most
+/// [`AUTO_CHAIN_TURN`]) and either long — more than [`AUTO_CHAIN_EDGES`] edges, or at least
+/// [`AUTO_CHAIN_LENGTH`] of the diagonal — or running between ends of long chains (a short CAD
+/// edge from corner to corner). Measured on CAD parts and organic meshes
+/// (paper-notes "Feature lines"): a part's creases are long, smooth chains (anchor, joint,
+/// part, fandisk: 10-32 edges per chain, ≥ 90 % of their edges in such chains); the sharp
+/// edges of an organic mesh are short jagged runs (bunny, cow, armadillo, knight: 1-2.4 edges
+/// per chain), whose faces the feature lines would pin into slivers.
+fn smooth_chains(mesh: &TriMesh, topo: &Topology, lines: Vec<EdgeKey>) -> Vec<EdgeKey> {
+    if lines.is_empty() {
+        return lines;
+    }
+    let cos_turn = AUTO_CHAIN_TURN.to_radians().cos();
+    let p = |v: VertexId| mesh.positions[v.idx()];
+    let chains: Vec<Vec<VertexId>> = feature_chains(mesh, topo, &lines, &[])
+        .into_iter()
+        .filter(|c| {
+            c.windows(3).all(|w| {
+                let (d0, d1) = (p(w[1]) - p(w[0]), p(w[2]) - p(w[1]));
+                d0.dot(&d1) >= cos_turn * d0.norm() * d1.norm()
+            })
+        })
+        .collect();
+    // Long chains first (in edges, or in length: a CAD part's flat sides meet along single
+    // long edges); then the short ones whose two ends are corners of long ones.
+    let long_length = AUTO_CHAIN_LENGTH * mesh.bbox_diagonal();
+    let long = |c: &Vec<VertexId>| {
+        c.len() > AUTO_CHAIN_EDGES
+            || c.windows(2)
+                .map(|w| (p(w[1]) - p(w[0])).norm())
+                .sum::<f64>()
+                >= long_length
+    };
+    let mut long_ends: HashMap<VertexId, usize> = HashMap::new();
+    for c in chains.iter().filter(|c| long(c)) {
+        for v in [c[0], c[c.len() - 1]] {
+            *long_ends.entry(v).or_default() += 1;
+        }
+    }
+    let mut out: Vec<EdgeKey> = Vec::new();
+    for c in &chains {
+        let ends_on_long = [c[0], c[c.len() - 1]]
+            .iter()
+            .all(|v| long_ends.contains_key(v));
+        if long(c) || ends_on_long {
+            out.extend(c.windows(2).map(|w| EdgeKey::new(w[0], w[1])));
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 /// How many times sharper than the other edges of its two faces a crease of
@@ -420,30 +488,32 @@ pub enum FeatureError {
     },
 }
 
-/// The feature lines of Algorithm 1's working mesh (before the loop): the input edges `rule`
-/// picks, each split into pieces of about `l_tar` in `metrics` (the metric the planar
-/// remesher sees, one tensor per reference vertex).
+/// The feature lines of Algorithm 1's working mesh (before the loop): the input edges `sharp`
+/// (the run's [`FeatureRule`] picks them), resampled to pieces of about `l_tar` in `metrics` (the metric the planar remesher
+/// sees, one tensor per reference vertex), with `corners[v]` kept as chain nodes
+/// ([`resample_feature_lines`]), each piece's chord within `max_deviation` of the crease.
 pub fn split_to_target(
     work: &mut WorkingMesh,
     reference: &TriMesh,
     topo: &Topology,
-    rule: FeatureRule,
+    sharp: &[EdgeKey],
+    corners: &[bool],
     metrics: &[nalgebra::Matrix3<f64>],
     l_tar: f64,
+    max_deviation: f64,
 ) -> Result<FeatureLines, FeatureError> {
-    let sharp = rule.edges(reference, topo);
     if sharp.is_empty() {
         return Ok(FeatureLines::default());
     }
-    let counts: Vec<f64> = sharp
+    // An upper bound on the new vertices (every edge split on its own).
+    let new_vertices: f64 = sharp
         .iter()
         .map(|e| {
             let d = reference.positions[e.1.idx()] - reference.positions[e.0.idx()];
             let mm = (metrics[e.0.idx()] + metrics[e.1.idx()]) * 0.5;
-            (d.dot(&(mm * d)).max(0.0).sqrt() / l_tar).round().max(1.0)
+            (d.dot(&(mm * d)).max(0.0).sqrt() / l_tar).round().max(1.0) - 1.0
         })
-        .collect();
-    let new_vertices: f64 = counts.iter().map(|k| k - 1.0).sum();
+        .sum();
     if new_vertices.is_nan() || new_vertices > MAX_NEW_VERTICES as f64 {
         return Err(FeatureError::TooManyVertices {
             new_vertices,
@@ -451,12 +521,16 @@ pub fn split_to_target(
             edges: sharp.len(),
         });
     }
-    let with_k: Vec<_> = sharp
-        .iter()
-        .zip(&counts)
-        .map(|(e, k)| (*e, *k as usize))
-        .collect();
-    Ok(split_feature_edges(work, reference, &with_k))
+    Ok(resample_feature_lines(
+        work,
+        reference,
+        topo,
+        sharp,
+        corners,
+        metrics,
+        l_tar,
+        max_deviation,
+    ))
 }
 
 #[cfg(test)]
@@ -509,6 +583,75 @@ mod tests {
         assert_eq!(FeatureRule::parse("0"), Ok(FeatureRule::Off));
         assert_eq!(FeatureRule::parse("30"), Ok(FeatureRule::Angle(30.0)));
         assert!(FeatureRule::parse("-5").is_err() && FeatureRule::parse("x").is_err());
+    }
+
+    /// The chain filter of the automatic rule on hand-made lines over a 20×20 plate: long
+    /// straight runs (7 edges, or 3 edges spanning ≥ 0.1 of the diagonal) stay, and so does a
+    /// 2-edge run between the ends of two long ones; an isolated 2-edge run and a staircase
+    /// (every turn 90°: jagged, as on a scan) go.
+    #[test]
+    fn smooth_chains_keeps_long_smooth_lines_and_drops_jagged_ones() {
+        let m = generators::plate(1.0, 20);
+        let topo = Topology::build(&m);
+        let at: HashMap<(i64, i64), VertexId> = m
+            .vertices()
+            .map(|v| {
+                let p = m.positions[v.idx()];
+                (
+                    ((p.x * 20.0).round() as i64, (p.y * 20.0).round() as i64),
+                    v,
+                )
+            })
+            .collect();
+        let run = |pts: &[(i64, i64)]| -> Vec<EdgeKey> {
+            pts.windows(2)
+                .map(|w| EdgeKey::new(at[&w[0]], at[&w[1]]))
+                .collect()
+        };
+        let row = |y: i64, x0: i64, x1: i64| (x0..=x1).map(|x| (x, y)).collect::<Vec<_>>();
+        let col = |x: i64, y0: i64, y1: i64| (y0..=y1).map(|y| (x, y)).collect::<Vec<_>>();
+        let long_row = run(&row(10, 2, 9));
+        let long_a = run(&col(14, 2, 9));
+        let long_b = run(&col(16, 2, 9));
+        let joiner = run(&row(9, 14, 16));
+        let short_length_long = run(&row(19, 10, 13));
+        let isolated = run(&row(4, 2, 4));
+        let stairs = run(&[
+            (2, 16),
+            (3, 16),
+            (3, 17),
+            (4, 17),
+            (4, 18),
+            (5, 18),
+            (5, 19),
+        ]);
+        let mut all = Vec::new();
+        for l in [
+            &long_row,
+            &long_a,
+            &long_b,
+            &joiner,
+            &short_length_long,
+            &isolated,
+            &stairs,
+        ] {
+            all.extend(l.iter().copied());
+        }
+        all.sort_unstable();
+        let kept: HashSet<EdgeKey> = smooth_chains(&m, &topo, all).into_iter().collect();
+        for (name, l, keep) in [
+            ("7-edge row", &long_row, true),
+            ("7-edge column", &long_a, true),
+            ("joiner", &joiner, true),
+            ("3 edges, 0.106 of the diagonal", &short_length_long, true),
+            ("isolated 2-edge run", &isolated, false),
+            ("staircase", &stairs, false),
+        ] {
+            for e in l {
+                assert_eq!(kept.contains(e), keep, "{name}: {e:?}");
+            }
+        }
+        assert_eq!(kept.len(), 7 + 7 + 7 + 2 + 3);
     }
 
     /// Splitting keeps an oriented manifold of the same topology and area; every new vertex
