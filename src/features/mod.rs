@@ -22,7 +22,10 @@ use nalgebra::Point3;
 use std::collections::{HashMap, HashSet};
 
 mod resample;
-pub use resample::{crease_scale, feature_chains, resample_feature_lines, NODE_TURN, SNAP};
+pub use resample::{
+    crease_scale, feature_chains, resample_feature_lines, PieceTarget, MAX_CREASE_FACTOR,
+    NODE_TURN, SNAP,
+};
 
 /// Most vertices a feature split may add (a target far below the feature edges' length
 /// would otherwise ask for an unbounded allocation).
@@ -120,7 +123,10 @@ pub const AUTO_MIN_EDGES: usize = 3;
 /// [`AUTO_MAX_TURN`]); a line is kept when it is closed, or joins other sharp edges at both
 /// ends (a CAD edge from corner to corner, however short), or has at least
 /// [`AUTO_MIN_EDGES`] edges. What is dropped are short open runs of sharp edges: the isolated
-/// spikes and folds of a scan or of a coarse organic mesh.
+/// spikes and folds of a scan or of a coarse organic mesh. Then the lines are cut into chains
+/// at their nodes ([`feature_chains`]) and only smooth, long chains stay (every turn at most
+/// [`AUTO_CHAIN_TURN`]; more than [`AUTO_CHAIN_EDGES`] edges or at least [`AUTO_CHAIN_LENGTH`]
+/// of the diagonal), with the short ones that run between two ends of long ones.
 pub fn auto_feature_edges(mesh: &TriMesh, topo: &Topology) -> Vec<EdgeKey> {
     let sharp = contrasted(mesh, topo, sharp_edges(mesh, topo, AUTO_ANGLE));
     if sharp.is_empty() {
@@ -202,14 +208,15 @@ pub fn auto_feature_edges(mesh: &TriMesh, topo: &Topology) -> Vec<EdgeKey> {
 }
 
 /// A chain (between nodes, [`feature_chains`]) with more edges than this is long for
-/// [`smooth_chains`].
+/// the chain filter of [`auto_feature_edges`].
 pub const AUTO_CHAIN_EDGES: usize = 4;
 
 /// A chain at least this long (fraction of the bounding-box diagonal) is long for
-/// [`smooth_chains`], whatever its edge count.
+/// the chain filter of [`auto_feature_edges`], whatever its edge count.
 pub const AUTO_CHAIN_LENGTH: f64 = 0.1;
 
-/// Largest turn (degrees) between consecutive edges of a chain [`smooth_chains`] keeps.
+/// Largest turn (degrees) between consecutive edges of a chain that the chain filter of
+/// [`auto_feature_edges`] keeps.
 pub const AUTO_CHAIN_TURN: f64 = 30.0;
 
 /// The chains of `lines` that look like a CAD part's creases: smooth (every turn at most
@@ -489,22 +496,21 @@ pub enum FeatureError {
 }
 
 /// The feature lines of Algorithm 1's working mesh (before the loop): the input edges `sharp`
-/// (the run's [`FeatureRule`] picks them), resampled to pieces of about `l_tar` in `metrics` (the metric the planar remesher
-/// sees, one tensor per reference vertex), with `corners[v]` kept as chain nodes
-/// ([`resample_feature_lines`]), each piece's chord within `max_deviation` of the crease.
+/// (the run's [`FeatureRule`] picks them), resampled to `target` ([`resample_feature_lines`])
+/// with `corners[v]` kept as chain nodes. Errors when the target is so small that the lines
+/// would get more than [`MAX_NEW_VERTICES`] vertices.
 pub fn split_to_target(
     work: &mut WorkingMesh,
     reference: &TriMesh,
     topo: &Topology,
     sharp: &[EdgeKey],
     corners: &[bool],
-    metrics: &[nalgebra::Matrix3<f64>],
-    l_tar: f64,
-    max_deviation: f64,
+    target: &PieceTarget<'_>,
 ) -> Result<FeatureLines, FeatureError> {
     if sharp.is_empty() {
         return Ok(FeatureLines::default());
     }
+    let (metrics, l_tar) = (target.metrics, target.l_tar);
     // An upper bound on the new vertices (every edge split on its own).
     let new_vertices: f64 = sharp
         .iter()
@@ -522,14 +528,7 @@ pub fn split_to_target(
         });
     }
     Ok(resample_feature_lines(
-        work,
-        reference,
-        topo,
-        sharp,
-        corners,
-        metrics,
-        l_tar,
-        max_deviation,
+        work, reference, topo, sharp, corners, target,
     ))
 }
 

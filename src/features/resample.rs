@@ -323,6 +323,18 @@ pub fn crease_scale(
     s
 }
 
+/// What a feature line is resampled to: pieces of metric length `l_tar` in `metrics` (one
+/// tensor per reference vertex), each chord within `max_deviation` of the crease (0: no bound).
+#[derive(Clone, Copy, Debug)]
+pub struct PieceTarget<'a> {
+    /// The metric the planar remesher sees, per reference vertex.
+    pub metrics: &'a [Matrix3<f64>],
+    /// Target metric edge length.
+    pub l_tar: f64,
+    /// Largest distance from a piece's chord to the crease it replaces (unit space).
+    pub max_deviation: f64,
+}
+
 /// Resample every feature chain of `sharp` to pieces of about `l_tar` in `metrics` (see the
 /// module docs). Returns the feature lines: pieces, pinned vertices, positions.
 pub fn resample_feature_lines(
@@ -331,10 +343,13 @@ pub fn resample_feature_lines(
     topo: &Topology,
     sharp: &[EdgeKey],
     extra_node: &[bool],
-    metrics: &[Matrix3<f64>],
-    l_tar: f64,
-    max_deviation: f64,
+    target: &PieceTarget<'_>,
 ) -> FeatureLines {
+    let PieceTarget {
+        metrics,
+        l_tar,
+        max_deviation,
+    } = *target;
     let chains = feature_chains(reference, topo, sharp, extra_node);
     let metric_len = |a: VertexId, b: VertexId| {
         let d = reference.positions[b.idx()] - reference.positions[a.idx()];
@@ -563,16 +578,12 @@ mod tests {
         let mut w = WorkingMesh::from_reference(m);
         let metrics = vec![Matrix3::identity(); m.n_vertices()];
         let none = vec![false; m.n_vertices()];
-        let lines = resample_feature_lines(
-            &mut w,
-            m,
-            &topo,
-            &sharp,
-            &none,
-            &metrics,
+        let target = PieceTarget {
+            metrics: &metrics,
             l_tar,
             max_deviation,
-        );
+        };
+        let lines = resample_feature_lines(&mut w, m, &topo, &sharp, &none, &target);
         (w, lines)
     }
 

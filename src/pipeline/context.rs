@@ -225,9 +225,11 @@ impl LoopState {
             &ctx.reference_topology,
             &ctx.plan.feature_edges,
             &ctx.corners,
-            ctx.field().vertex_metrics(),
-            ctx.plan.l_tar,
-            ctx.plan.options.fidelity.max_deviation,
+            &crate::features::PieceTarget {
+                metrics: ctx.field().vertex_metrics(),
+                l_tar: ctx.plan.l_tar,
+                max_deviation: ctx.plan.options.fidelity.max_deviation,
+            },
         )
         .map_err(|e| PipelineError::Input(e.to_string()))?;
         let pinned = (0..work.mesh.n_vertices())
