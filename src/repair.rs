@@ -108,12 +108,16 @@ pub struct RepairLog {
     pub split_vertices: Vec<Split>,
     /// Vertices no kept face references (not in the output).
     pub unreferenced_vertices: Vec<VertexId>,
+    /// File faces that use a vertex twice, left out when the file was read
+    /// ([`crate::io::ReadOptions::drop_repeated_indices`]; file face numbers, not mesh ids).
+    pub repeated_index_faces: Vec<crate::io::RepeatedIndexFace>,
 }
 
 impl RepairLog {
     /// True when the repair changed nothing but dropping unreferenced vertices.
     pub fn is_empty(&self) -> bool {
         self.welded.is_empty()
+            && self.repeated_index_faces.is_empty()
             && self.dropped_faces.is_empty()
             && self.flipped_faces.is_empty()
             && self.cut_edges.is_empty()
@@ -125,9 +129,13 @@ impl RepairLog {
         let count =
             |r: fn(&DropReason) -> bool| self.dropped_faces.iter().filter(|d| r(&d.reason)).count();
         format!(
-            "welded {} vertices; dropped {} faces ({} collapsed, {} zero-area, {} repeated); \
+            "{}welded {} vertices; dropped {} faces ({} collapsed, {} zero-area, {} repeated); \
              flipped {} faces; cut {} non-manifold edges; split {} vertices; \
              left out {} unreferenced vertices",
+            match self.repeated_index_faces.len() {
+                0 => String::new(),
+                n => format!("left out {n} file faces that use a vertex twice; "),
+            },
             self.welded.len(),
             self.dropped_faces.len(),
             count(|r| *r == DropReason::Collapsed),

@@ -194,3 +194,82 @@ fn a_moebius_band_is_refused_by_name_with_no_output() {
     assert!(stderr(&o).contains("moebius.ply"), "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+/// Faces that use a vertex twice (an OBJ face `f 1 1 2`, an STL facet whose corners weld into
+/// one) are refused by name without `--repair`, naming it; with it they are left out, listed
+/// in the report by file face and line, and the rest is remeshed.
+#[test]
+fn faces_that_repeat_a_vertex_are_refused_naming_repair_and_left_out_with_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let torus = generators::torus(1.0, 0.4, 16, 8);
+    // OBJ: the torus plus one face naming vertex 1 twice (file face `n`, the last line).
+    let obj = dir.path().join("repeated.obj");
+    conemesh::io::write_mesh(&obj, &torus).expect("write");
+    let mut text = std::fs::read_to_string(&obj).expect("read back");
+    text.push_str("f 1 1 2\n");
+    let last_line = text.lines().count();
+    std::fs::write(&obj, &text).expect("append");
+    // STL: the torus as a soup plus a facet with two equal corners.
+    let stl = dir.path().join("degenerate.stl");
+    let mut solid = String::from("solid t\n");
+    let tri = |t: [nalgebra::Point3<f64>; 3]| {
+        let mut f = String::from("facet normal 0 0 0\nouter loop\n");
+        for p in t {
+            f.push_str(&format!("vertex {} {} {}\n", p.x, p.y, p.z));
+        }
+        f + "endloop\nendfacet\n"
+    };
+    for t in &torus.triangles {
+        solid.push_str(&tri(t.map(|v| torus.positions[v.idx()])));
+    }
+    let p0 = torus.positions[0];
+    solid.push_str(&tri([p0, p0, torus.positions[1]]));
+    solid.push_str("endsolid t\n");
+    std::fs::write(&stl, solid).expect("write stl");
+
+    for (input, face, line) in [
+        (&obj, torus.n_faces(), last_line),
+        // ASCII STL: the line of the facet's first corner.
+        (&stl, torus.n_faces(), 2 + 7 * torus.n_faces() + 2),
+    ] {
+        let stem = input.file_stem().and_then(|s| s.to_str()).expect("stem");
+        let out = dir.path().join(format!("{stem}-out.obj"));
+        let rep = dir.path().join(format!("{stem}-report.json"));
+        let o = conemesh(&["remesh", s(input), "-o", s(&out), "-q"]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        let e = stderr(&o);
+        assert!(
+            e.contains(&format!("face {face} repeats vertex")) && e.contains("--repair"),
+            "{e}"
+        );
+        assert!(!out.exists(), "no output after a refusal");
+
+        let o = conemesh(&[
+            "remesh",
+            s(input),
+            "-o",
+            s(&out),
+            "--report",
+            s(&rep),
+            "--repair",
+            "-q",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("left out 1 file faces that use a vertex twice"),
+            "{}",
+            stderr(&o)
+        );
+        let r = report(&rep);
+        let listed = r["repair"]["repeated_index_faces"]
+            .as_array()
+            .expect("list");
+        assert_eq!(listed.len(), 1);
+        assert_eq!(listed[0]["face"], serde_json::json!(face));
+        assert_eq!(listed[0]["line"], serde_json::json!(line));
+        let remeshed = conemesh::io::read_mesh(&out).expect("read").mesh;
+        let topo = Topology::build(&remeshed);
+        assert!(topo.is_oriented_manifold());
+        assert_eq!(topo.components()[0].genus, Some(1));
+    }
+}

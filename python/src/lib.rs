@@ -326,15 +326,21 @@ fn remesh_job(
     let repaired = match args.repair {
         false => None,
         true => Some(
-            cli_remesh::repaired_input(args, mesh.clone(), metric.map(<[_]>::to_vec), "the input")
-                .map_err(
-                    |e| match e.downcast_ref::<conemesh::repair::RepairError>() {
-                        Some(conemesh::repair::RepairError::Unrepaired(v)) => {
-                            errors::with_invariant(Failure::input(format!("{e:#}")), v)
-                        }
-                        _ => Failure::input(format!("{e:#}")),
-                    },
-                )?,
+            cli_remesh::repaired_input(
+                args,
+                mesh.clone(),
+                metric.map(<[_]>::to_vec),
+                "the input",
+                Vec::new(),
+            )
+            .map_err(
+                |e| match e.downcast_ref::<conemesh::repair::RepairError>() {
+                    Some(conemesh::repair::RepairError::Unrepaired(v)) => {
+                        errors::with_invariant(Failure::input(format!("{e:#}")), v)
+                    }
+                    _ => Failure::input(format!("{e:#}")),
+                },
+            )?,
         ),
     };
     let (mesh, metric, repair) = match &repaired {

@@ -198,10 +198,11 @@ pub struct RemeshArgs {
     /// Algorithm 2: the weight w of Eq. 5 [1] (`eq5.w`).
     #[arg(long)]
     pub improve_w: Option<f64>,
-    /// Repair the input before remeshing: weld vertices at bit-identical positions, drop
-    /// collapsed, zero-area and repeated faces, orient each component consistently, cut
-    /// edges with three or more faces and split vertices with several fans. Coordinates
-    /// are not moved; the report (`repair`) lists every change by element.
+    /// Repair the input before remeshing: leave out file faces that use a vertex twice, weld
+    /// vertices at bit-identical positions, drop collapsed, zero-area and repeated faces,
+    /// orient each component consistently, cut edges with three or more faces and split
+    /// vertices with several fans. Coordinates are not moved; the report (`repair`) lists
+    /// every change by element.
     #[arg(long)]
     pub repair: bool,
     /// No progress bar.
@@ -216,15 +217,25 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = args.threads {
         set_threads(n)?;
     }
-    let (name, mesh) = match &args.mesh {
+    // With `--repair` a face that uses a vertex twice is left out (and listed) instead of
+    // refusing the file.
+    let read = conemesh::io::ReadOptions {
+        drop_repeated_indices: args.repair,
+    };
+    let (name, mesh, repeated) = match &args.mesh {
         Some(p) => {
-            let loaded =
-                conemesh::io::read_mesh(p).with_context(|| format!("reading {}", p.display()))?;
-            (p.display().to_string(), loaded.mesh)
+            let loaded = conemesh::io::read_mesh_with(p, &read)
+                .with_context(|| format!("reading {}", p.display()))?;
+            (
+                p.display().to_string(),
+                loaded.mesh,
+                loaded.repeated_index_faces,
+            )
         }
         None => (
             "built-in torus".to_string(),
             conemesh::mesh::generators::default_surface(),
+            Vec::new(),
         ),
     };
     let short_name = args
@@ -245,7 +256,7 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         mesh,
         metric,
         repair,
-    } = repaired_input(&args, mesh, metric, &name)?;
+    } = repaired_input(&args, mesh, metric, &name, repeated)?;
     let remesher = Remesher::new(options(&args)).with_stages(stages(&args, metric.is_some())?);
     let bar = progress_bar(args.quiet, mesh.n_faces() as u64);
     let result = remesher.run_with(&mesh, metric.as_deref(), |p: Progress| {
@@ -343,13 +354,15 @@ pub struct RunInput {
     pub repair: Option<conemesh::repair::RepairLog>,
 }
 
-/// With `--repair`, the repaired input and the log of changes (one line on stderr);
-/// without, the input as read.
+/// With `--repair`, the repaired input and the log of changes (one line on stderr), which
+/// lists `repeated`, the file faces the reader left out for using a vertex twice; without,
+/// the input as read.
 pub fn repaired_input(
     args: &RemeshArgs,
     mesh: conemesh::TriMesh,
     metric: Option<Vec<nalgebra::Matrix3<f64>>>,
     name: &str,
+    repeated: Vec<conemesh::io::RepeatedIndexFace>,
 ) -> anyhow::Result<RunInput> {
     if !args.repair {
         return Ok(RunInput {
@@ -358,8 +371,9 @@ pub fn repaired_input(
             repair: None,
         });
     }
-    let r = conemesh::repair::repair(&mesh, &Default::default())
+    let mut r = conemesh::repair::repair(&mesh, &Default::default())
         .with_context(|| format!("repairing {name}"))?;
+    r.log.repeated_index_faces = repeated;
     eprintln!("repair: {}", r.log.summary());
     Ok(RunInput {
         metric: metric.map(|m| r.vertex_values(&m)),

@@ -125,8 +125,9 @@ pub const AUTO_MIN_EDGES: usize = 3;
 /// [`AUTO_MIN_EDGES`] edges. What is dropped are short open runs of sharp edges: the isolated
 /// spikes and folds of a scan or of a coarse organic mesh. Then the lines are cut into chains
 /// at their nodes ([`feature_chains`]) and only smooth, long chains stay (every turn at most
-/// [`AUTO_CHAIN_TURN`]; more than [`AUTO_CHAIN_EDGES`] edges or at least [`AUTO_CHAIN_LENGTH`]
-/// of the diagonal), with the short ones that run between two ends of long ones.
+/// [`AUTO_CHAIN_TURN`]; more than [`AUTO_CHAIN_EDGES`] edges, or straight and at least
+/// [`AUTO_CHAIN_LENGTH`] of the diagonal), with the short ones that run between two ends of
+/// long ones.
 pub fn auto_feature_edges(mesh: &TriMesh, topo: &Topology) -> Vec<EdgeKey> {
     let sharp = contrasted(mesh, topo, sharp_edges(mesh, topo, AUTO_ANGLE));
     if sharp.is_empty() {
@@ -209,19 +210,23 @@ pub fn auto_feature_edges(mesh: &TriMesh, topo: &Topology) -> Vec<EdgeKey> {
 
 /// A chain (between nodes, [`feature_chains`]) with more edges than this is long for
 /// the chain filter of [`auto_feature_edges`].
-pub const AUTO_CHAIN_EDGES: usize = 4;
+pub const AUTO_CHAIN_EDGES: usize = 5;
 
-/// A chain at least this long (fraction of the bounding-box diagonal) is long for
-/// the chain filter of [`auto_feature_edges`], whatever its edge count.
+/// A straight chain (every turn at most [`AUTO_STRAIGHT_TURN`]) at least this long (fraction of
+/// the bounding-box diagonal) is long for the chain filter of [`auto_feature_edges`], whatever
+/// its edge count: where a CAD part's flat sides meet along a few long edges.
 pub const AUTO_CHAIN_LENGTH: f64 = 0.1;
+
+/// Largest turn (degrees) of a chain that is long by [`AUTO_CHAIN_LENGTH`].
+pub const AUTO_STRAIGHT_TURN: f64 = 5.0;
 
 /// Largest turn (degrees) between consecutive edges of a chain that the chain filter of
 /// [`auto_feature_edges`] keeps.
 pub const AUTO_CHAIN_TURN: f64 = 30.0;
 
 /// The chains of `lines` that look like a CAD part's creases: smooth (every turn at most
-/// [`AUTO_CHAIN_TURN`]) and either long — more than [`AUTO_CHAIN_EDGES`] edges, or at least
-/// [`AUTO_CHAIN_LENGTH`] of the diagonal — or running between ends of long chains (a short CAD
+/// [`AUTO_CHAIN_TURN`]) and either long — more than [`AUTO_CHAIN_EDGES`] edges, or straight
+/// and at least [`AUTO_CHAIN_LENGTH`] of the diagonal — or running between ends of long chains (a short CAD
 /// edge from corner to corner). Measured on CAD parts and organic meshes
 /// (paper-notes "Feature lines"): a part's creases are long, smooth chains (anchor, joint,
 /// part, fandisk: 10-32 edges per chain, ≥ 90 % of their edges in such chains); the sharp
@@ -245,12 +250,14 @@ fn smooth_chains(mesh: &TriMesh, topo: &Topology, lines: Vec<EdgeKey>) -> Vec<Ed
     // Long chains first (in edges, or in length: a CAD part's flat sides meet along single
     // long edges); then the short ones whose two ends are corners of long ones.
     let long_length = AUTO_CHAIN_LENGTH * mesh.bbox_diagonal();
+    let cos_straight = AUTO_STRAIGHT_TURN.to_radians().cos();
     let long = |c: &Vec<VertexId>| {
-        c.len() > AUTO_CHAIN_EDGES
-            || c.windows(2)
-                .map(|w| (p(w[1]) - p(w[0])).norm())
-                .sum::<f64>()
-                >= long_length
+        let straight = c.windows(3).all(|w| {
+            let (d0, d1) = (p(w[1]) - p(w[0]), p(w[2]) - p(w[1]));
+            d0.dot(&d1) >= cos_straight * d0.norm() * d1.norm()
+        });
+        let length: f64 = c.windows(2).map(|w| (p(w[1]) - p(w[0])).norm()).sum();
+        c.len() > AUTO_CHAIN_EDGES || (straight && length >= long_length)
     };
     let mut long_ends: HashMap<VertexId, usize> = HashMap::new();
     for c in chains.iter().filter(|c| long(c)) {

@@ -133,7 +133,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
             warnings.push(format!("{path}: section `{tok}` skipped"));
         }
     }
-    let (mesh, polygons, origin) = build_mesh(path, F, positions, &faces)?;
+    let (mesh, polygons, origin, repeated) = build_mesh(path, F, positions, &faces)?;
     if polygons > 0 {
         warnings.push(format!(
             "{path}: {polygons} quadrilaterals fan-triangulated"
@@ -152,6 +152,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         welded_vertices: 0,
         warnings,
         attributes,
+        repeated_index_faces: repeated,
     })
 }
 

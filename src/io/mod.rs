@@ -147,7 +147,11 @@ pub enum IoError {
         vertex: usize,
     },
     /// A face uses the same vertex twice.
-    #[error("{path}{}: face {face} repeats vertex {vertex}", loc(.line))]
+    #[error(
+        "{path}{}: face {face} repeats vertex {vertex} (`conemesh remesh --repair` leaves such \
+         faces out)",
+        loc(.line)
+    )]
     RepeatedVertex {
         /// the file
         path: String,
@@ -245,6 +249,29 @@ pub struct LoadedMesh {
     /// Attributes found in the file (OBJ `vt`, PLY `u v`, PLY integer face properties and
     /// `red green blue`), per triangle after fan triangulation.
     pub attributes: MeshAttributes,
+    /// Faces that use a vertex twice (after STL's welding of corners), left out of `mesh`.
+    /// Only [`ReadOptions::drop_repeated_indices`] lets a read return them; otherwise the
+    /// first is an [`IoError::RepeatedVertex`].
+    pub repeated_index_faces: Vec<RepeatedIndexFace>,
+}
+
+/// A file face that uses a vertex twice, left out of the mesh read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct RepeatedIndexFace {
+    /// Face number in the file (0-based; STL: the facet).
+    pub face: usize,
+    /// 1-based line (0 for binary formats).
+    pub line: usize,
+    /// The repeated vertex (0-based, after welding for STL).
+    pub vertex: usize,
+}
+
+/// How a file is read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// Leave out faces that use a vertex twice and list them
+    /// ([`LoadedMesh::repeated_index_faces`]) instead of refusing the file (`remesh --repair`).
+    pub drop_repeated_indices: bool,
 }
 
 /// Optional per-element data to write with a mesh (formats that cannot hold an attribute
@@ -300,6 +327,11 @@ impl Format {
 
 /// Read a mesh, choosing the format by extension (`.obj`, `.off`, `.ply`, `.stl`, `.mesh`).
 pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
+    read_mesh_with(path, &ReadOptions::default())
+}
+
+/// [`read_mesh`] with options.
+pub fn read_mesh_with(path: &Path, options: &ReadOptions) -> Result<LoadedMesh, IoError> {
     let p = path.display().to_string();
     let format =
         Format::from_path(path).ok_or_else(|| IoError::UnsupportedFormat { path: p.clone() })?;
@@ -307,11 +339,41 @@ pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
         path: p.clone(),
         error,
     })?;
-    read_mesh_bytes(&bytes, format, &p)
+    read_mesh_bytes_with(&bytes, format, &p, options)
 }
 
 /// Read a mesh from bytes in a given format; `path` only names the source in errors.
 pub fn read_mesh_bytes(bytes: &[u8], format: Format, path: &str) -> Result<LoadedMesh, IoError> {
+    read_mesh_bytes_with(bytes, format, path, &ReadOptions::default())
+}
+
+/// [`read_mesh_bytes`] with options.
+pub fn read_mesh_bytes_with(
+    bytes: &[u8],
+    format: Format,
+    path: &str,
+    options: &ReadOptions,
+) -> Result<LoadedMesh, IoError> {
+    let mut loaded = read_any(bytes, format, path)?;
+    match loaded.repeated_index_faces.first() {
+        Some(r) if !options.drop_repeated_indices => Err(IoError::RepeatedVertex {
+            path: path.to_string(),
+            line: r.line,
+            face: r.face,
+            vertex: r.vertex,
+        }),
+        Some(_) => {
+            let n = loaded.repeated_index_faces.len();
+            loaded.warnings.push(format!(
+                "{path}: {n} faces that use a vertex twice left out (repair)"
+            ));
+            Ok(loaded)
+        }
+        None => Ok(loaded),
+    }
+}
+
+fn read_any(bytes: &[u8], format: Format, path: &str) -> Result<LoadedMesh, IoError> {
     match format {
         Format::Obj => obj::read(bytes, path),
         Format::Off => off::read(bytes, path),
@@ -463,13 +525,15 @@ impl RawFaces {
 }
 
 /// Check indices, fan-triangulate polygons and build the validated [`TriMesh`]. Returns the
-/// mesh, the number of polygons triangulated, and for each triangle the face it came from.
+/// mesh, the number of polygons triangulated, for each triangle the face it came from, and
+/// the faces left out because they use a vertex twice (the caller refuses them unless asked
+/// to drop them, [`read_mesh_bytes_with`]).
 pub(crate) fn build_mesh(
     path: &str,
     format: &'static str,
     positions: Vec<Point3<f64>>,
     faces: &RawFaces,
-) -> Result<(TriMesh, usize, Vec<usize>), IoError> {
+) -> Result<Built, IoError> {
     let n = positions.len();
     if faces.len() == 0 {
         return Err(IoError::NoFaces {
@@ -480,6 +544,7 @@ pub(crate) fn build_mesh(
     let mut tris: Vec<[usize; 3]> = Vec::with_capacity(faces.len());
     let mut origin = Vec::with_capacity(faces.len());
     let mut polygons = 0;
+    let mut repeated = Vec::new();
     for f in 0..faces.len() {
         let poly = faces.face(f);
         let line = faces.line[f];
@@ -502,15 +567,13 @@ pub(crate) fn build_mesh(
                 });
             }
         }
-        for (k, &i) in poly.iter().enumerate() {
-            if poly[..k].contains(&i) {
-                return Err(IoError::RepeatedVertex {
-                    path: path.to_string(),
-                    line,
-                    face: f,
-                    vertex: i as usize,
-                });
-            }
+        if let Some(k) = (1..poly.len()).find(|&k| poly[..k].contains(&poly[k])) {
+            repeated.push(RepeatedIndexFace {
+                face: f,
+                line,
+                vertex: poly[k] as usize,
+            });
+            continue;
         }
         if poly.len() > 3 {
             polygons += 1;
@@ -521,12 +584,25 @@ pub(crate) fn build_mesh(
             origin.push(f);
         }
     }
+    // Nothing left to repair when every face repeats a vertex.
+    if let (true, Some(r)) = (tris.is_empty(), repeated.first()) {
+        return Err(IoError::RepeatedVertex {
+            path: path.to_string(),
+            line: r.line,
+            face: r.face,
+            vertex: r.vertex,
+        });
+    }
     let mesh = TriMesh::from_indices(positions, &tris).map_err(|source| IoError::Mesh {
         path: path.to_string(),
         source,
     })?;
-    Ok((mesh, polygons, origin))
+    Ok((mesh, polygons, origin, repeated))
 }
+
+/// What [`build_mesh`] returns: mesh, polygons triangulated, source face per triangle, faces
+/// left out for a repeated vertex.
+pub(crate) type Built = (TriMesh, usize, Vec<usize>, Vec<RepeatedIndexFace>);
 
 /// The number of elements to pre-allocate for a header claiming `claimed` elements of at
 /// least `min_bytes` bytes each, when `available` bytes remain: never more than fits.

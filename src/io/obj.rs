@@ -175,7 +175,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         .map(|k| format!("{path}: unknown OBJ keyword `{k}` ignored"))
         .collect();
     let n_v = positions.len();
-    let (mesh, polygons, _) = build_mesh(path, F, positions, &faces)?;
+    let (mesh, polygons, _, repeated) = build_mesh(path, F, positions, &faces)?;
     if polygons > 0 {
         warnings.push(format!("{path}: {polygons} polygon faces fan-triangulated"));
     }
@@ -206,6 +206,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         welded_vertices: 0,
         warnings,
         attributes,
+        repeated_index_faces: repeated,
     })
 }
 

@@ -161,7 +161,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     if let Some((l, _)) = lines.next() {
         warnings.push(format!("{path}:{l}: data after the last face ignored"));
     }
-    let (mesh, polygons, _) = build_mesh(path, F, positions, &faces)?;
+    let (mesh, polygons, _, repeated) = build_mesh(path, F, positions, &faces)?;
     if polygons > 0 {
         warnings.push(format!("{path}: {polygons} polygon faces fan-triangulated"));
     }
@@ -171,6 +171,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         welded_vertices: 0,
         warnings,
         attributes: Default::default(),
+        repeated_index_faces: repeated,
     })
 }
 

@@ -581,7 +581,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         });
     }
     let n_v = positions.len();
-    let (mesh, polygons, origin) = build_mesh(path, F, positions, &faces)?;
+    let (mesh, polygons, origin, repeated) = build_mesh(path, F, positions, &faces)?;
     if polygons > 0 {
         warnings.push(format!("{path}: {polygons} polygon faces fan-triangulated"));
     }
@@ -602,6 +602,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         welded_vertices: 0,
         warnings,
         attributes,
+        repeated_index_faces: repeated,
     })
 }
 

@@ -55,7 +55,7 @@ impl Welder {
 
     fn finish(self, path: &str, mut warnings: Vec<String>) -> Result<LoadedMesh, IoError> {
         let welded = self.corners - self.positions.len();
-        let (mesh, _, _) = build_mesh(path, F, self.positions, &self.faces)?;
+        let (mesh, _, _, repeated) = build_mesh(path, F, self.positions, &self.faces)?;
         if welded > 0 {
             warnings.push(format!("{path}: {welded} duplicate facet corners welded"));
         }
@@ -65,6 +65,7 @@ impl Welder {
             welded_vertices: welded,
             warnings,
             attributes: Default::default(),
+            repeated_index_faces: repeated,
         })
     }
 }
