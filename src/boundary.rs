@@ -311,7 +311,8 @@ pub fn curve_distance(
     }
 }
 
-fn point_segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
+/// Distance from `p` to the segment `[a, b]` (to `a` when the segment is a point).
+pub(crate) fn point_segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     let e = b - a;
     let l2 = e.norm_squared();
     let t = if l2 > 0.0 {

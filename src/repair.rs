@@ -6,8 +6,10 @@
 //! each has one repair that does not move a single coordinate:
 //! 1. **weld**: vertices with bit-identical positions (−0 = +0) become one (STL-style soups,
 //!    split UV seams), the lowest id kept;
-//! 2. **drop**: faces that welding collapsed, faces of exactly zero area (`collinear3d`,
-//!    exact) and repeated faces (the same three vertices, in either orientation);
+//! 2. **drop**: faces that welding collapsed, repeated faces (the same three vertices, in
+//!    either orientation) and faces of exactly zero area (`collinear3d`, exact) — except that a
+//!    zero-area face whose middle corner lies on an edge shared with one other face is first
+//!    removed by flipping that edge, which keeps the surface closed (a T-junction's sliver);
 //! 3. **orient**: each edge-connected component is oriented consistently by a breadth-first
 //!    walk over its manifold edges, keeping the orientation most of its faces already had
 //!    (ties: that of its first face); a component that cannot be oriented (a Möbius band) is
@@ -75,6 +77,16 @@ pub struct DroppedFace {
     pub reason: DropReason,
 }
 
+/// A zero-area face `face`, whose middle corner lies on the edge it shares with `across`: the
+/// edge was flipped, so the two faces became two of positive area over `across`'s triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct ZeroAreaFlip {
+    /// the zero-area input face
+    pub face: FaceId,
+    /// the input face across its longest edge
+    pub across: FaceId,
+}
+
 /// An input vertex welded into an earlier one at the same position.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct Weld {
@@ -102,6 +114,9 @@ pub struct RepairLog {
     pub dropped_faces: Vec<DroppedFace>,
     /// Faces whose orientation was reversed.
     pub flipped_faces: Vec<FaceId>,
+    /// Zero-area faces removed by flipping the edge their middle corner lies on, with the face
+    /// across it (the two faces are replaced by two that tile the same surface).
+    pub zero_area_flips: Vec<ZeroAreaFlip>,
     /// Edges (after welding) that had three or more faces and were cut.
     pub cut_edges: Vec<EdgeKey>,
     /// Vertices split into one per fan (output ids).
@@ -119,6 +134,7 @@ impl RepairLog {
         self.welded.is_empty()
             && self.repeated_index_faces.is_empty()
             && self.dropped_faces.is_empty()
+            && self.zero_area_flips.is_empty()
             && self.flipped_faces.is_empty()
             && self.cut_edges.is_empty()
             && self.split_vertices.is_empty()
@@ -130,7 +146,7 @@ impl RepairLog {
             |r: fn(&DropReason) -> bool| self.dropped_faces.iter().filter(|d| r(&d.reason)).count();
         format!(
             "{}welded {} vertices; dropped {} faces ({} collapsed, {} zero-area, {} repeated); \
-             flipped {} faces; cut {} non-manifold edges; split {} vertices; \
+             flipped {} zero-area faces away; flipped {} faces; cut {} non-manifold edges; split {} vertices; \
              left out {} unreferenced vertices",
             match self.repeated_index_faces.len() {
                 0 => String::new(),
@@ -141,6 +157,7 @@ impl RepairLog {
             count(|r| *r == DropReason::Collapsed),
             count(|r| *r == DropReason::ZeroArea),
             count(|r| matches!(r, DropReason::Duplicate(_))),
+            self.zero_area_flips.len(),
             self.flipped_faces.len(),
             self.cut_edges.len(),
             self.split_vertices.len(),
@@ -275,6 +292,7 @@ fn kept_faces(
     let mut faces = Vec::with_capacity(mesh.n_faces());
     let mut tris = Vec::with_capacity(mesh.n_faces());
     let mut first_with: std::collections::HashMap<[VertexId; 3], FaceId> = Default::default();
+    let mut zero = Vec::new();
     for f in mesh.faces() {
         let t = mesh.face(f).map(|v| rep[v.idx()]);
         let reason = if !drop_degenerate {
@@ -301,6 +319,13 @@ fn kept_faces(
             }
         };
         match reason {
+            // A zero-area face stays for now: flipping its long edge may remove it without
+            // opening a hole (`flip_zero_area`).
+            Some(DropReason::ZeroArea) => {
+                zero.push(faces.len());
+                faces.push(f);
+                tris.push(t);
+            }
             Some(reason) => log.dropped_faces.push(DroppedFace { face: f, reason }),
             None => {
                 faces.push(f);
@@ -308,7 +333,118 @@ fn kept_faces(
             }
         }
     }
+    let unflipped = flip_zero_area(mesh, &faces, &mut tris, &zero, log);
+    if !unflipped.is_empty() {
+        for &k in &unflipped {
+            log.dropped_faces.push(DroppedFace {
+                face: faces[k],
+                reason: DropReason::ZeroArea,
+            });
+        }
+        log.dropped_faces.sort_by_key(|d| d.face);
+        let gone: std::collections::HashSet<usize> = unflipped.into_iter().collect();
+        let mut k = 0;
+        faces.retain(|_| {
+            k += 1;
+            !gone.contains(&(k - 1))
+        });
+        let mut k = 0;
+        tris.retain(|_| {
+            k += 1;
+            !gone.contains(&(k - 1))
+        });
+    }
     (faces, tris)
+}
+
+/// Remove the zero-area faces `zero` (indices into `tris`) by edge flips where one keeps the
+/// surface: a face whose corners are exactly collinear has one corner `c` strictly inside the
+/// segment of the other two, `a`–`b` (bit-identical corners were welded). When exactly one
+/// other face `G` has the edge `a`–`b`, traversing it as `x → y`, with third corner `d`, the
+/// two faces become `(y, d, c)` and `(d, x, c)`: they tile `G`'s triangle (the zero-area face
+/// covers nothing), keep `G`'s orientation, and are kept only when both have positive area
+/// (exact) and the edge `c`–`d` is new. Flips repeat until none applies. Returns the faces
+/// left with zero area (to drop).
+fn flip_zero_area(
+    mesh: &TriMesh,
+    faces: &[FaceId],
+    tris: &mut [[VertexId; 3]],
+    zero: &[usize],
+    log: &mut RepairLog,
+) -> Vec<usize> {
+    if zero.is_empty() {
+        return Vec::new();
+    }
+    let mut at_edge: std::collections::HashMap<EdgeKey, Vec<usize>> = Default::default();
+    for (k, t) in tris.iter().enumerate() {
+        for i in 0..3 {
+            at_edge.entry(EdgeKey::new(t[i], t[(i + 1) % 3])).or_default().push(k);
+        }
+    }
+    let p = |v: VertexId| mesh.position(v);
+    // The corner strictly between the other two (coordinates compared exactly).
+    let middle = |t: [VertexId; 3]| -> usize {
+        (0..3)
+            .find(|&i| {
+                let (a, b, c) = (p(t[(i + 1) % 3]), p(t[(i + 2) % 3]), p(t[i]));
+                (0..3).all(|k| (a[k] <= c[k] && c[k] <= b[k]) || (b[k] <= c[k] && c[k] <= a[k]))
+            })
+            .unwrap_or(0)
+    };
+    let mut pending: Vec<usize> = zero.to_vec();
+    loop {
+        let before = pending.len();
+        pending.retain(|&k| {
+            let t = tris[k];
+            // Flipped away already, as the face across another one.
+            if !collinear3d(p(t[0]), p(t[1]), p(t[2])) {
+                return false;
+            }
+            let m = middle(t);
+            let (c, a, b) = (t[m], t[(m + 1) % 3], t[(m + 2) % 3]);
+            let edge = EdgeKey::new(a, b);
+            let others: Vec<usize> = at_edge[&edge].iter().copied().filter(|&g| g != k).collect();
+            let [g] = others[..] else { return true };
+            let tg = tris[g];
+            let Some(i) = (0..3).find(|&i| EdgeKey::new(tg[i], tg[(i + 1) % 3]) == edge) else {
+                return true;
+            };
+            let (x, y, d) = (tg[i], tg[(i + 1) % 3], tg[(i + 2) % 3]);
+            let new = [[y, d, c], [d, x, c]];
+            if d == c
+                || at_edge.contains_key(&EdgeKey::new(c, d))
+                || new.iter().any(|n| collinear3d(p(n[0]), p(n[1]), p(n[2])))
+            {
+                return true;
+            }
+            for (face, old) in [(k, t), (g, tg)] {
+                for i in 0..3 {
+                    let e = EdgeKey::new(old[i], old[(i + 1) % 3]);
+                    if let Some(list) = at_edge.get_mut(&e) {
+                        list.retain(|&h| h != face);
+                        if list.is_empty() {
+                            at_edge.remove(&e);
+                        }
+                    }
+                }
+            }
+            tris[k] = new[0];
+            tris[g] = new[1];
+            for (face, t) in [(k, new[0]), (g, new[1])] {
+                for i in 0..3 {
+                    at_edge.entry(EdgeKey::new(t[i], t[(i + 1) % 3])).or_default().push(face);
+                }
+            }
+            log.zero_area_flips.push(ZeroAreaFlip {
+                face: faces[k],
+                across: faces[g],
+            });
+            false
+        });
+        if pending.len() == before {
+            return pending;
+        }
+    }
 }
 
 /// Across edge `i` of each kept face (from corner `i` to corner `i + 1`): the other face's
@@ -668,6 +804,47 @@ mod tests {
         assert!(certified(&r.mesh));
         assert_eq!(r.mesh.n_faces(), n as usize);
         assert_eq!(r.log.unreferenced_vertices.len(), 3, "{:?}", r.log);
+    }
+
+    /// A T-junction sealed by a zero-area face, as exporters leave them: the cube's edge `a`–`b`
+    /// has the midpoint `m` on one side only, with the sliver `(a, b, m)`. The repair flips the
+    /// sliver away instead of dropping it: the cube stays closed, of area 6, and nothing is
+    /// dropped. The sliver alone, with no face across its long edge, is dropped.
+    #[test]
+    fn a_zero_area_sliver_is_flipped_away_keeping_the_surface_closed() {
+        let mut m = generators::cube(2);
+        let topo = Topology::build(&m);
+        // An axis-aligned edge (its midpoint is exact) with faces on both sides.
+        let (f1, i) = m
+            .faces()
+            .flat_map(|f| (0..3).map(move |i| (f, i)))
+            .find(|&(f, i)| {
+                let t = m.face(f);
+                let d = m.position(t[(i + 1) % 3]) - m.position(t[i]);
+                d.iter().filter(|x| **x != 0.0).count() == 1 && topo.neighbor(f, i).is_some()
+            })
+            .expect("an axis-aligned edge");
+        let t = m.face(f1);
+        let (a, b, c) = (t[i], t[(i + 1) % 3], t[(i + 2) % 3]);
+        let mid = VertexId(m.positions.len() as u32);
+        m.positions
+            .push(Point3::from((m.position(a).coords + m.position(b).coords) * 0.5));
+        m.triangles[f1.idx()] = [a, mid, c];
+        m.triangles.push([mid, b, c]);
+        m.triangles.push([a, b, mid]);
+        let sliver = FaceId(m.n_faces() as u32 - 1);
+        assert!(Topology::build(&m).is_oriented_manifold());
+        let r = repair(&m, &RepairOptions::default()).expect("repairs");
+        assert!(r.log.dropped_faces.is_empty(), "{:?}", r.log.dropped_faces);
+        assert_eq!(r.log.zero_area_flips.len(), 1);
+        assert_eq!(r.log.zero_area_flips[0].face, sliver);
+        assert_eq!(r.log.zero_area_flips[0].across, topo.neighbor(f1, i).expect("across"));
+        assert!(certified(&r.mesh));
+        let t2 = Topology::build(&r.mesh);
+        assert!(t2.boundary_loops().is_empty(), "still closed");
+        assert_eq!(t2.euler_characteristic(), 2);
+        assert!((r.mesh.area() - 6.0).abs() < 1e-12);
+        assert!(r.log.summary().contains("flipped 1 zero-area faces away"));
     }
 
     #[test]

@@ -50,6 +50,16 @@ impl FeatureLines {
     pub fn is_pinned(&self, v: VertexId) -> bool {
         self.pinned.get(v.idx()).copied().unwrap_or(false)
     }
+
+    /// Pin the vertices `on_lines` of `work` (all others unpinned) at their positions there.
+    fn pin(&mut self, work: &WorkingMesh, on_lines: Vec<VertexId>) {
+        let mut flags = vec![false; work.mesh.n_vertices()];
+        for v in on_lines {
+            flags[v.idx()] = true;
+            self.positions.insert(v, work.mesh.positions[v.idx()]);
+        }
+        self.pinned = flags;
+    }
 }
 
 /// Which input edges are feature lines.
@@ -474,12 +484,7 @@ pub fn split_feature_edges(
         }
         pinned.extend(chain);
     }
-    let mut flags = vec![false; work.mesh.n_vertices()];
-    for v in pinned {
-        flags[v.idx()] = true;
-        lines.positions.insert(v, work.mesh.positions[v.idx()]);
-    }
-    lines.pinned = flags;
+    lines.pin(work, pinned);
     lines
 }
 

@@ -20,6 +20,7 @@
 //! surface ([`crate::lift`]).
 
 use super::{EdgeSplitter, FeatureLines};
+use crate::boundary::point_segment_distance;
 use crate::ids::{EdgeKey, VertexId};
 use crate::mesh::{Topology, TriMesh};
 use crate::predicates::collinear3d;
@@ -224,17 +225,6 @@ fn deviation(reference: &TriMesh, chain: &[VertexId], ends: &[End]) -> f64 {
     worst
 }
 
-fn point_segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
-}
-
 /// Largest factor [`crease_scale`] gives a vertex (sizes shrink by at most its square root, 5×,
 /// as the a-priori fidelity factor's cap).
 pub const MAX_CREASE_FACTOR: f64 = 25.0;
@@ -301,25 +291,9 @@ pub fn crease_scale(
         let want = l_tar * l_tar * kappa / (8.0 * eps * along);
         s[v.idx()] = want.clamp(1.0, MAX_CREASE_FACTOR.min(floor_cap));
     }
-    // Gradation over the faces (Jacobi passes: independent of the vertex order), as far as
-    // the factor needs to fall back to 1.
+    // Graded over the faces, as far as the factor needs to fall back to 1.
     let passes = (MAX_CREASE_FACTOR.ln() / CREASE_GRADE2.ln()).ceil() as usize;
-    for _ in 0..passes {
-        let prev = s.clone();
-        let mut changed = false;
-        for t in &reference.triangles {
-            let m = t.iter().map(|v| prev[v.idx()]).fold(1.0, f64::max) / CREASE_GRADE2;
-            for v in t {
-                if s[v.idx()] < m {
-                    s[v.idx()] = m;
-                    changed = true;
-                }
-            }
-        }
-        if !changed {
-            break;
-        }
-    }
+    crate::fidelity::grade_factors(reference, &mut s, CREASE_GRADE2, passes);
     s
 }
 
@@ -448,12 +422,7 @@ pub fn resample_feature_lines(
         pinned.extend(kept);
     }
     collapser.finish(work);
-    let mut flags = vec![false; work.mesh.n_vertices()];
-    for v in pinned {
-        flags[v.idx()] = true;
-        lines.positions.insert(v, work.mesh.positions[v.idx()]);
-    }
-    lines.pinned = flags;
+    lines.pin(work, pinned);
     lines
 }
 
