@@ -378,7 +378,10 @@ fn flip_zero_area(
     let mut at_edge: std::collections::HashMap<EdgeKey, Vec<usize>> = Default::default();
     for (k, t) in tris.iter().enumerate() {
         for i in 0..3 {
-            at_edge.entry(EdgeKey::new(t[i], t[(i + 1) % 3])).or_default().push(k);
+            at_edge
+                .entry(EdgeKey::new(t[i], t[(i + 1) % 3]))
+                .or_default()
+                .push(k);
         }
     }
     let p = |v: VertexId| mesh.position(v);
@@ -432,7 +435,10 @@ fn flip_zero_area(
             tris[g] = new[1];
             for (face, t) in [(k, new[0]), (g, new[1])] {
                 for i in 0..3 {
-                    at_edge.entry(EdgeKey::new(t[i], t[(i + 1) % 3])).or_default().push(face);
+                    at_edge
+                        .entry(EdgeKey::new(t[i], t[(i + 1) % 3]))
+                        .or_default()
+                        .push(face);
                 }
             }
             log.zero_area_flips.push(ZeroAreaFlip {
@@ -827,8 +833,9 @@ mod tests {
         let t = m.face(f1);
         let (a, b, c) = (t[i], t[(i + 1) % 3], t[(i + 2) % 3]);
         let mid = VertexId(m.positions.len() as u32);
-        m.positions
-            .push(Point3::from((m.position(a).coords + m.position(b).coords) * 0.5));
+        m.positions.push(Point3::from(
+            (m.position(a).coords + m.position(b).coords) * 0.5,
+        ));
         m.triangles[f1.idx()] = [a, mid, c];
         m.triangles.push([mid, b, c]);
         m.triangles.push([a, b, mid]);
@@ -838,7 +845,10 @@ mod tests {
         assert!(r.log.dropped_faces.is_empty(), "{:?}", r.log.dropped_faces);
         assert_eq!(r.log.zero_area_flips.len(), 1);
         assert_eq!(r.log.zero_area_flips[0].face, sliver);
-        assert_eq!(r.log.zero_area_flips[0].across, topo.neighbor(f1, i).expect("across"));
+        assert_eq!(
+            r.log.zero_area_flips[0].across,
+            topo.neighbor(f1, i).expect("across")
+        );
         assert!(certified(&r.mesh));
         let t2 = Topology::build(&r.mesh);
         assert!(t2.boundary_loops().is_empty(), "still closed");
