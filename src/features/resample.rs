@@ -293,7 +293,7 @@ pub fn crease_scale(
     }
     // Graded over the faces, as far as the factor needs to fall back to 1.
     let passes = (MAX_CREASE_FACTOR.ln() / CREASE_GRADE2.ln()).ceil() as usize;
-    crate::fidelity::grade_factors(reference, &mut s, CREASE_GRADE2, passes);
+    crate::mesh::grade_factors(reference, &mut s, CREASE_GRADE2, passes);
     s
 }
 

@@ -98,28 +98,6 @@ pub fn a_priori_scale(
         })
         .collect();
     // Gradation: a factor may exceed a neighbour's by at most GRADE².
-    grade_factors(reference, &mut s, GRADE * GRADE, 8);
+    crate::mesh::grade_factors(reference, &mut s, GRADE * GRADE, 8);
     s
-}
-
-/// Raise per-vertex factors `s` so that within every face of `mesh` none exceeds another by
-/// more than `ratio`, in at most `passes` Jacobi passes over the faces (so the result does not
-/// depend on the vertex order); factors never fall below 1.
-pub fn grade_factors(mesh: &TriMesh, s: &mut [f64], ratio: f64, passes: usize) {
-    for _ in 0..passes {
-        let prev = s.to_vec();
-        let mut changed = false;
-        for t in &mesh.triangles {
-            let m = t.iter().map(|v| prev[v.idx()]).fold(1.0, f64::max) / ratio;
-            for v in t {
-                if s[v.idx()] < m {
-                    s[v.idx()] = m;
-                    changed = true;
-                }
-            }
-        }
-        if !changed {
-            break;
-        }
-    }
 }

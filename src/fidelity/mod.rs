@@ -23,7 +23,7 @@ mod rounds;
 #[cfg(test)]
 mod tests;
 
-pub use apriori::{a_priori_scale, grade_factors};
+pub use apriori::a_priori_scale;
 pub use measure::{deviations, patch_vertex_factors, scale_metric, LiftedPatch, ScaleLimits};
 pub use rounds::{
     patch_metrics, refine, PatchFactors, PatchVertices, Refined, RoundOutput, RoundsSetup,
