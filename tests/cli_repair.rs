@@ -35,6 +35,20 @@ fn shuffled_torus() -> (TriMesh, usize) {
     (m, n)
 }
 
+/// `conemesh remesh INPUT -o OUT --report REPORT --repair -q`.
+fn remesh_repaired(input: &Path, out: &Path, rep: &Path) -> Output {
+    conemesh(&[
+        "remesh",
+        s(input),
+        "-o",
+        s(out),
+        "--report",
+        s(rep),
+        "--repair",
+        "-q",
+    ])
+}
+
 fn report(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).expect("report")).expect("json")
 }
@@ -125,16 +139,7 @@ fn two_surfaces_touching_at_a_vertex_are_split_and_remeshed_apart() {
     conemesh::io::write_mesh(&input, &m).expect("write");
     let out = dir.path().join("out.obj");
     let rep = dir.path().join("report.json");
-    let o = conemesh(&[
-        "remesh",
-        s(&input),
-        "-o",
-        s(&out),
-        "--report",
-        s(&rep),
-        "--repair",
-        "-q",
-    ]);
+    let o = remesh_repaired(&input, &out, &rep);
     assert!(o.status.success(), "{}", stderr(&o));
     let r = report(&rep);
     assert_eq!(r["repair"]["welded"].as_array().map(Vec::len), Some(1));
@@ -244,16 +249,7 @@ fn faces_that_repeat_a_vertex_are_refused_naming_repair_and_left_out_with_it() {
         );
         assert!(!out.exists(), "no output after a refusal");
 
-        let o = conemesh(&[
-            "remesh",
-            s(input),
-            "-o",
-            s(&out),
-            "--report",
-            s(&rep),
-            "--repair",
-            "-q",
-        ]);
+        let o = remesh_repaired(input, &out, &rep);
         assert!(o.status.success(), "{}", stderr(&o));
         assert!(
             stderr(&o).contains("left out 1 file faces that use a vertex twice"),

@@ -44,6 +44,15 @@ fn segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     (p - (a + ab * t)).norm()
 }
 
+/// `output` scored against `input` (file units), after asserting that it has no flipped face,
+/// no self-intersection and the input's topology.
+fn evaluated_valid(input: &TriMesh, output: &TriMesh) -> conemesh::quality::EvalReport {
+    let eval = evaluate(input, output, None, &EvalOptions::default()).expect("eval");
+    assert!(eval.flips.is_empty() && eval.self_intersections.is_empty());
+    assert!(eval.topology_kept);
+    eval
+}
+
 /// A lens (normals 80° apart across its equator) at unit diagonal.
 fn lens() -> TriMesh {
     let m = generators::lens(50f64.to_radians(), 8, 40);
@@ -153,15 +162,7 @@ fn fandisk_keeps_its_sharp_edges() {
         d <= tol,
         "a sharp edge is {d} from the output (tolerance {tol})"
     );
-    let eval = evaluate(
-        &file_mesh,
-        &norm.unapply(&r.mesh),
-        None,
-        &EvalOptions::default(),
-    )
-    .expect("eval");
-    assert!(eval.flips.is_empty() && eval.self_intersections.is_empty());
-    assert!(eval.topology_kept);
+    let eval = evaluated_valid(&file_mesh, &norm.unapply(&r.mesh));
     let q = &eval.output_quality;
     assert!(q.q_avg >= 0.85 && q.theta_avg >= 47.0, "{q:?}");
     assert!(
@@ -312,15 +313,7 @@ fn a_cad_can_keeps_its_rims_at_the_defaults() {
         }
     }
     assert!(on_rims >= r.report.feature_pieces, "{on_rims} rim vertices");
-    let eval = evaluate(
-        &file_mesh,
-        &norm.unapply(&r.mesh),
-        None,
-        &EvalOptions::default(),
-    )
-    .expect("eval");
-    assert!(eval.flips.is_empty() && eval.self_intersections.is_empty());
-    assert!(eval.topology_kept);
+    let eval = evaluated_valid(&file_mesh, &norm.unapply(&r.mesh));
     let q = &eval.output_quality;
     let h = eval.distance.hausdorff_rel;
     assert!(q.q_avg >= 0.80, "{q:?}");
