@@ -22,6 +22,7 @@
 use super::{EdgeSplitter, FeatureLines};
 use crate::boundary::point_segment_distance;
 use crate::ids::{EdgeKey, VertexId};
+use crate::invariants::FlipTest;
 use crate::mesh::{Topology, TriMesh};
 use crate::predicates::collinear3d;
 use crate::stitch::WorkingMesh;
@@ -367,7 +368,7 @@ pub fn resample_feature_lines(
         paths.push((path, flags));
     }
     // 2. Collapse the vertices between ends towards the nearer end.
-    let mut collapser = Collapser::new(work);
+    let mut collapser = Collapser::new(work, reference);
     let mut lines = FeatureLines {
         input_edges: sharp.len(),
         ..FeatureLines::default()
@@ -432,10 +433,13 @@ struct Collapser {
     /// Per vertex: the live faces around it.
     faces_at: Vec<Vec<usize>>,
     dead: Vec<bool>,
+    /// The run's flip certificate against the reference: a face a collapse changes may be
+    /// kept as it is if no patch reaches it, so it must not face away from the input.
+    flips: FlipTest,
 }
 
 impl Collapser {
-    fn new(work: &WorkingMesh) -> Collapser {
+    fn new(work: &WorkingMesh, reference: &TriMesh) -> Collapser {
         let mut faces_at = vec![Vec::new(); work.mesh.n_vertices()];
         for (f, t) in work.mesh.triangles.iter().enumerate() {
             for v in t {
@@ -445,6 +449,7 @@ impl Collapser {
         Collapser {
             faces_at,
             dead: vec![false; work.mesh.n_faces()],
+            flips: FlipTest::new(reference),
         }
     }
 
@@ -459,7 +464,9 @@ impl Collapser {
     /// Collapse the edge `v`–`w` into `w` when it is an interior edge with exactly two faces,
     /// the link condition holds (the only common neighbours of `v` and `w` are those two
     /// faces' third corners, so the topology is kept), and every face that keeps `v`'s place
-    /// stays non-degenerate (exact) and tilts by less than 60°. Returns whether it collapsed.
+    /// stays non-degenerate (exact), tilts by less than 60° and passes the run's flip
+    /// certificate against the reference ([`FlipTest::is_flipped_anywhere`]). Returns whether
+    /// it collapsed.
     fn try_collapse(&mut self, work: &mut WorkingMesh, v: VertexId, w: VertexId) -> bool {
         let tri = |f: usize| work.mesh.triangles[f];
         let around = &self.faces_at[v.idx()];
@@ -497,7 +504,9 @@ impl Collapser {
             }
             let old = normal(tri(f).map(pos));
             let new = normal([a, b, c]);
-            if old.dot(&new) < MIN_NORMAL_COS * old.norm() * new.norm() {
+            if old.dot(&new) < MIN_NORMAL_COS * old.norm() * new.norm()
+                || self.flips.is_flipped_anywhere(&[a, b, c])
+            {
                 return false;
             }
         }
@@ -558,7 +567,7 @@ mod tests {
 
     /// The live part of the working mesh is a valid surface of the input's topology: an
     /// oriented manifold with the same Euler characteristic, `processed` parallel, no
-    /// degenerate face (exact).
+    /// degenerate face (exact), none facing away from the input (the run's flip certificate).
     fn assert_valid(w: &WorkingMesh, m: &TriMesh) {
         let (live, _) = w.mesh.without_unreferenced_vertices();
         let t = Topology::build(&live);
@@ -568,9 +577,14 @@ mod tests {
             Topology::build(m).euler_characteristic()
         );
         assert_eq!(w.processed.len(), w.mesh.n_faces());
+        let flips = FlipTest::new(m);
         for tri in &w.mesh.triangles {
             let [a, b, c] = tri.map(|v| w.mesh.positions[v.idx()]);
             assert!(!collinear3d(&a, &b, &c), "{tri:?} is degenerate");
+            assert!(
+                !flips.is_flipped_anywhere(&[a, b, c]),
+                "{tri:?} faces away from the input"
+            );
         }
     }
 
