@@ -226,7 +226,9 @@ pub fn from_pipeline(e: &PipelineError) -> Failure {
             patch,
             seed,
         ),
-        PipelineError::Final(inv) | PipelineError::FileUnits(inv) => {
+        PipelineError::Final(inv)
+        | PipelineError::FileUnits(inv)
+        | PipelineError::FeatureLines(inv) => {
             with_invariant(Failure::new("CertificateError", msg), inv)
         }
         PipelineError::CornerLost(v) => {

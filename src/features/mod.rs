@@ -31,7 +31,8 @@ pub use resample::{
 /// would otherwise ask for an unbounded allocation).
 pub const MAX_NEW_VERTICES: usize = 10_000_000;
 
-/// The feature lines of a working mesh after [`split_feature_edges`].
+/// The feature lines of a working mesh after [`resample_feature_lines`] (or
+/// [`split_feature_edges`]).
 #[derive(Clone, Debug, Default)]
 pub struct FeatureLines {
     /// The pieces of the input's feature edges, by working-mesh vertex ids.

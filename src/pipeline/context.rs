@@ -239,7 +239,18 @@ impl LoopState {
             .collect();
         let topo = match features.edges.is_empty() {
             true => ctx.reference_topology.clone(),
-            false => Topology::build(&work.mesh),
+            false => {
+                // The stage's certificate: the collapses kept an oriented manifold without
+                // degenerate faces (exact) and the input's topology.
+                let topo = Topology::build(&work.mesh);
+                let (live, _) = work.mesh.without_unreferenced_vertices();
+                invariants::certify_manifold(&work.mesh, &topo)
+                    .and_then(|()| invariants::certify_oriented(&work.mesh, &topo))
+                    .and_then(|()| invariants::certify_no_degenerate_faces(&work.mesh))
+                    .and_then(|()| invariants::certify_same_topology(reference, &live))
+                    .map_err(PipelineError::FeatureLines)?;
+                topo
+            }
         };
         let bound = work
             .locations

@@ -128,6 +128,10 @@ pub enum PipelineError {
         /// where the offending patch was written
         debug_file: Option<PathBuf>,
     },
+    /// The working mesh failed its certificate after the feature lines were resampled, before
+    /// the loop.
+    #[error("after resampling the feature lines: {0}")]
+    FeatureLines(#[source] InvariantError),
     /// The final mesh self-intersects.
     #[error("final mesh: {0}")]
     Final(#[source] InvariantError),
