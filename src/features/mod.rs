@@ -519,6 +519,7 @@ pub fn split_to_target(
     sharp: &[EdgeKey],
     corners: &[bool],
     target: &PieceTarget<'_>,
+    flips: &crate::invariants::FlipTest,
 ) -> Result<FeatureLines, FeatureError> {
     if sharp.is_empty() {
         return Ok(FeatureLines::default());
@@ -541,7 +542,7 @@ pub fn split_to_target(
         });
     }
     Ok(resample_feature_lines(
-        work, reference, topo, sharp, corners, target,
+        work, reference, topo, sharp, corners, target, flips,
     ))
 }
 

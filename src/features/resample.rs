@@ -311,7 +311,8 @@ pub struct PieceTarget<'a> {
 }
 
 /// Resample every feature chain of `sharp` to pieces of about `l_tar` in `metrics` (see the
-/// module docs). Returns the feature lines: pieces, pinned vertices, positions.
+/// module docs); `flips` is the run's flip certificate on `reference`. Returns the feature
+/// lines: pieces, pinned vertices, positions.
 pub fn resample_feature_lines(
     work: &mut WorkingMesh,
     reference: &TriMesh,
@@ -319,6 +320,7 @@ pub fn resample_feature_lines(
     sharp: &[EdgeKey],
     extra_node: &[bool],
     target: &PieceTarget<'_>,
+    flips: &FlipTest,
 ) -> FeatureLines {
     let PieceTarget {
         metrics,
@@ -368,7 +370,7 @@ pub fn resample_feature_lines(
         paths.push((path, flags));
     }
     // 2. Collapse the vertices between ends towards the nearer end.
-    let mut collapser = Collapser::new(work, reference);
+    let mut collapser = Collapser::new(work, flips);
     let mut lines = FeatureLines {
         input_edges: sharp.len(),
         ..FeatureLines::default()
@@ -429,17 +431,17 @@ pub fn resample_feature_lines(
 
 /// Edge collapses on the working mesh before the loop: faces are marked dead and dropped at
 /// [`Collapser::finish`]; vertices stay in the arrays (unreferenced, as after a stitch).
-struct Collapser {
+struct Collapser<'a> {
     /// Per vertex: the live faces around it.
     faces_at: Vec<Vec<usize>>,
     dead: Vec<bool>,
     /// The run's flip certificate against the reference: a face a collapse changes may be
     /// kept as it is if no patch reaches it, so it must not face away from the input.
-    flips: FlipTest,
+    flips: &'a FlipTest,
 }
 
-impl Collapser {
-    fn new(work: &WorkingMesh, reference: &TriMesh) -> Collapser {
+impl<'a> Collapser<'a> {
+    fn new(work: &WorkingMesh, flips: &'a FlipTest) -> Collapser<'a> {
         let mut faces_at = vec![Vec::new(); work.mesh.n_vertices()];
         for (f, t) in work.mesh.triangles.iter().enumerate() {
             for v in t {
@@ -449,7 +451,7 @@ impl Collapser {
         Collapser {
             faces_at,
             dead: vec![false; work.mesh.n_faces()],
-            flips: FlipTest::new(reference),
+            flips,
         }
     }
 
@@ -561,7 +563,8 @@ mod tests {
             l_tar,
             max_deviation,
         };
-        let lines = resample_feature_lines(&mut w, m, &topo, &sharp, &none, &target);
+        let lines =
+            resample_feature_lines(&mut w, m, &topo, &sharp, &none, &target, &FlipTest::new(m));
         (w, lines)
     }
 

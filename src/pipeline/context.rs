@@ -230,6 +230,7 @@ impl LoopState {
                 l_tar: ctx.plan.l_tar,
                 max_deviation: ctx.plan.options.fidelity.max_deviation,
             },
+            &ctx.flip_test,
         )
         .map_err(|e| PipelineError::Input(e.to_string()))?;
         let pinned = (0..work.mesh.n_vertices())
