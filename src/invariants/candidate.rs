@@ -95,21 +95,48 @@ pub fn certify_candidate_embedded(
     patch_faces: &[FaceId],
     r: &Replacement,
 ) -> Result<(), InvariantError> {
-    let (positions, new_tris) = candidate_arrays(work, r);
-    let Some((lo, hi)) = bbox_of(new_tris.iter().flatten().map(|v| positions[v.idx()])) else {
+    let base = work.mesh.n_vertices() as u32;
+    let position = |v: VertexId| match v.0.checked_sub(base) {
+        Some(i) => r.new_positions[i as usize],
+        None => work.mesh.positions[v.idx()],
+    };
+    let new_tris: Vec<[VertexId; 3]> = r
+        .triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| match v {
+                PatchVertex::Existing(g) => g,
+                PatchVertex::New(i) => VertexId(base + i),
+            })
+        })
+        .collect();
+    let Some((lo, hi)) = bbox_of(new_tris.iter().flatten().map(|&v| position(v))) else {
         return Ok(());
     };
-    let in_patch: HashSet<FaceId> = patch_faces.iter().copied().collect();
+    let mut in_patch = patch_faces.to_vec();
+    in_patch.sort_unstable();
     let n_new = new_tris.len();
     let mut tris = new_tris;
+    // One pass over the faces with a box test, and a small mesh of what is near: the run
+    // calls this for every candidate, so nothing here is proportional to the whole mesh but
+    // the scan itself.
     for (f, t) in work.mesh.triangles.iter().enumerate() {
-        if in_patch.contains(&FaceId::new(f)) {
-            continue;
-        }
-        if let Some((a, b)) = bbox_of(t.iter().map(|v| positions[v.idx()])) {
-            if (0..3).all(|k| a[k] <= hi[k] && b[k] >= lo[k]) {
+        if let Some((a, b)) = bbox_of(t.iter().map(|v| work.mesh.positions[v.idx()])) {
+            if (0..3).all(|k| a[k] <= hi[k] && b[k] >= lo[k])
+                && in_patch.binary_search(&FaceId::new(f)).is_err()
+            {
                 tris.push(*t);
             }
+        }
+    }
+    let mut local_id: HashMap<VertexId, VertexId> = HashMap::new();
+    let mut positions = Vec::new();
+    for t in &mut tris {
+        for v in t.iter_mut() {
+            *v = *local_id.entry(*v).or_insert_with(|| {
+                positions.push(position(*v));
+                VertexId::new(positions.len() - 1)
+            });
         }
     }
     let local = TriMesh {

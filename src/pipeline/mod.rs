@@ -44,7 +44,7 @@ mod step;
 pub use error::{PipelineError, Stage, StageError};
 pub use options::{
     default_improvers, Cancel, CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO,
-    DEFAULT_BATCH, DEFAULT_IMPROVERS, FACE_BUDGET,
+    DEFAULT_BATCH, DEFAULT_IMPROVERS, DENSE_INPUT_RATIO, FACE_BUDGET,
 };
 pub use records::{
     AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,

@@ -139,6 +139,13 @@ pub const FACE_BUDGET: f64 = 12.0;
 /// multiplies the expected output face count ([`super::expected_faces`]) by at least this much.
 pub const COARSE_RATIO: f64 = 2.0;
 
+/// [`CoarseInput::Auto`] leaves the profile off when the input has more than this many times
+/// the faces the a-priori fidelity scaling expects of the output: its edges are then shorter
+/// than the output's on average (by √2 at this ratio), so the first sweep's seams are not the
+/// long input edges the profile's further sweeps are for. Of the inputs measured only CGAL's
+/// cheese is that dense (3.5×; the coarse ones 1.1–1.4×, paper-notes "Coarse inputs").
+pub const DENSE_INPUT_RATIO: f64 = 2.0;
+
 /// When [`super::remesh`] uses [`RemeshOptions::coarse_profile`] (paper-notes "Coarse inputs").
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize)]
 pub enum CoarseInput {

@@ -3,7 +3,7 @@
 //! coarse-input profile runs.
 
 use super::error::PipelineError;
-use super::options::{CoarseInput, RemeshOptions, TargetLength, COARSE_RATIO};
+use super::options::{CoarseInput, RemeshOptions, TargetLength, COARSE_RATIO, DENSE_INPUT_RATIO};
 use crate::fidelity;
 use crate::ids::VertexId;
 use crate::mesh::{Topology, TriMesh};
@@ -110,12 +110,14 @@ impl Plan {
         let expected_fidelity =
             expected_faces(reference, field.vertex_metrics(), &fid_scale, l_tar);
         // An input where the distance tolerance, not the metric, sets the output's size runs
-        // the coarse-input profile (paper-notes "Coarse inputs"); its finer floor needs the
+        // the coarse-input profile (paper-notes "Coarse inputs"), unless it is already finer
+        // than that output: then its edges, the first sweep's seams, are shorter than the
+        // output's, which is what the profile's sweeps are for. Its finer floor needs the
         // a-priori scaling again.
         let coarse = match options.coarse_input {
             CoarseInput::On => true,
             CoarseInput::Off => false,
-            CoarseInput::Auto => expected_fidelity >= COARSE_RATIO * expected,
+            CoarseInput::Auto => is_coarse(reference.n_faces(), expected, expected_fidelity),
         };
         let options = if coarse {
             let profile = options.coarse_profile();
@@ -247,6 +249,14 @@ pub fn expected_faces(
 
 /// The expected output face counts of a run with `options` ([`expected_faces`] at its L_tar,
 /// in the metric alone and with the a-priori fidelity scaling) and whether
+/// [`CoarseInput::Auto`]'s rule: the a-priori fidelity scaling multiplies the expected output
+/// by at least [`COARSE_RATIO`], and the input has at most [`DENSE_INPUT_RATIO`] times the
+/// faces of that output.
+fn is_coarse(faces_in: usize, expected: f64, expected_fidelity: f64) -> bool {
+    expected_fidelity >= COARSE_RATIO * expected
+        && faces_in as f64 <= DENSE_INPUT_RATIO * expected_fidelity
+}
+
 /// [`CoarseInput::Auto`] would run the coarse-input profile.
 pub fn coarse_input_estimate(
     field: &MetricField,
@@ -265,6 +275,25 @@ pub fn coarse_input_estimate(
 mod tests {
     use super::*;
     use nalgebra::Point3;
+
+    /// The rule on measured counts (faces in, expected, expected with the a-priori scaling):
+    /// decimated-knight and the coarse CAD parts run the profile; CGAL's cheese, whose
+    /// input is 3.5 times finer than the output, and a smooth scan do not.
+    #[test]
+    fn the_coarse_rule_on_measured_counts() {
+        assert!(is_coarse(1_000, 339.0, 888.0), "decimated-knight");
+        assert!(is_coarse(3_714, 1_066.0, 3_060.0), "couplingdown");
+        assert!(is_coarse(4_800, 1_257.0, 3_457.0), "rotor_small");
+        assert!(!is_coarse(17_786, 2_411.0, 5_115.0), "cheese");
+        assert!(
+            !is_coarse(5_000, 8_000.0, 9_200.0),
+            "a smooth scan (ratio 1.15)"
+        );
+        // The ratio alone is not enough, and neither is the density alone.
+        assert!(!is_coarse(1_000, 2_000.0, 3_999.0));
+        assert!(!is_coarse(8_001, 1_000.0, 4_000.0));
+        assert!(is_coarse(8_000, 1_000.0, 4_000.0));
+    }
 
     /// A flat unit square in the identity metric (restricted to the plane): its area over
     /// that of an equilateral triangle of side L; a scale of 4 everywhere quadruples it.

@@ -9,6 +9,8 @@
 //!
 //! Built by sorting, not hashing, so that every list comes out in a deterministic order.
 
+mod update;
+
 use super::{TriMesh, UnionFind};
 use crate::ids::{EdgeKey, FaceId, HalfedgeId, VertexId};
 use serde::Serialize;
@@ -134,24 +136,7 @@ impl Topology {
             i = j;
         }
 
-        // Vertex → faces (CSR).
-        let mut vf_offsets = vec![0u32; nv + 1];
-        for t in &mesh.triangles {
-            for v in t {
-                vf_offsets[v.idx() + 1] += 1;
-            }
-        }
-        for k in 0..nv {
-            vf_offsets[k + 1] += vf_offsets[k];
-        }
-        let mut fill = vf_offsets.clone();
-        let mut vf_faces = vec![FaceId(0); 3 * nf];
-        for (f, t) in mesh.triangles.iter().enumerate() {
-            for v in t {
-                vf_faces[fill[v.idx()] as usize] = FaceId::new(f);
-                fill[v.idx()] += 1;
-            }
-        }
+        let (vf_offsets, vf_faces) = vertex_face_lists(mesh);
 
         // Components: faces joined through any shared edge.
         let mut face_component = vec![0u32; nf];
@@ -184,16 +169,32 @@ impl Topology {
             non_manifold_vertices: std::sync::OnceLock::new(),
         };
         topo.boundary_loops = topo.trace_boundary_loops();
-        topo.boundary_loop_component = topo
-            .boundary_loops
-            .iter()
-            .map(|l| {
-                let v = l[0];
-                topo.face_component[topo.vertex_faces(v)[0].idx()]
-            })
-            .collect();
+        topo.boundary_loop_component = topo.loop_components();
         topo.components = topo.summarise_components(n_comp as usize);
         topo
+    }
+
+    /// The component of each boundary loop (of a face at its first vertex).
+    fn loop_components(&self) -> Vec<u32> {
+        self.boundary_loops
+            .iter()
+            .map(|l| self.face_component[self.vertex_faces(l[0])[0].idx()])
+            .collect()
+    }
+
+    /// Each component's boundary loops from `boundary_loop_component`, and its χ and genus
+    /// from its counts.
+    fn recount_loops_and_genus(&mut self) {
+        for c in &mut self.components {
+            c.boundary_loops = 0;
+        }
+        for &l in &self.boundary_loop_component {
+            self.components[l as usize].boundary_loops += 1;
+        }
+        for c in &mut self.components {
+            c.euler = c.vertices as i64 - c.edges as i64 + c.faces as i64;
+            c.genus = genus(c.euler, c.boundary_loops);
+        }
     }
 
     fn find_non_manifold_vertices(&self) -> Vec<VertexId> {
@@ -305,19 +306,13 @@ impl Topology {
         (0..n)
             .map(|c| {
                 let euler = verts[c] as i64 - edges[c] as i64 + faces[c] as i64;
-                let twice_g = 2 - euler - loops[c] as i64;
-                let genus = if twice_g >= 0 && twice_g % 2 == 0 {
-                    Some((twice_g / 2) as u32)
-                } else {
-                    None
-                };
                 ComponentInfo {
                     faces: faces[c],
                     vertices: verts[c],
                     edges: edges[c],
                     boundary_loops: loops[c],
                     euler,
-                    genus,
+                    genus: genus(euler, loops[c]),
                 }
             })
             .collect()
@@ -464,6 +459,35 @@ impl Topology {
             && self.inconsistent_edges.is_empty()
             && self.non_manifold_vertices().is_empty()
     }
+}
+
+/// The genus from χ = 2 − 2g − b; `None` when it is not a non-negative integer.
+fn genus(euler: i64, loops: usize) -> Option<u32> {
+    let twice_g = 2 - euler - loops as i64;
+    (twice_g >= 0 && twice_g % 2 == 0).then_some((twice_g / 2) as u32)
+}
+
+/// Vertex → faces (CSR): each vertex's faces in id order.
+fn vertex_face_lists(mesh: &TriMesh) -> (Vec<u32>, Vec<FaceId>) {
+    let nv = mesh.n_vertices();
+    let mut vf_offsets = vec![0u32; nv + 1];
+    for t in &mesh.triangles {
+        for v in t {
+            vf_offsets[v.idx() + 1] += 1;
+        }
+    }
+    for k in 0..nv {
+        vf_offsets[k + 1] += vf_offsets[k];
+    }
+    let mut fill = vf_offsets.clone();
+    let mut vf_faces = vec![FaceId(0); 3 * mesh.n_faces()];
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        for v in t {
+            vf_faces[fill[v.idx()] as usize] = FaceId::new(f);
+            fill[v.idx()] += 1;
+        }
+    }
+    (vf_offsets, vf_faces)
 }
 
 #[cfg(test)]
