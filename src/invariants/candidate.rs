@@ -88,10 +88,13 @@ pub fn certify_replacement(
 /// Exact local self-intersection test of a candidate: the new faces against each other and
 /// against the working-mesh faces (outside the patch) whose bounding boxes meet the new faces'
 /// bounding box. Pairs of two old faces are not the candidate's doing and are ignored. Face ids
-/// in the error: `f0..` are the candidate's triangles, larger ids the old faces in the order
-/// they were gathered.
+/// in the error: `f0..` are the candidate's triangles, larger ids the old faces in id order.
+/// `near` finds those faces without a scan of the whole mesh; without it, every face's box is
+/// tested.
 pub fn certify_candidate_embedded(
     work: &WorkingMesh,
+    topo: &Topology,
+    near: Option<&NearFaces>,
     patch_faces: &[FaceId],
     r: &Replacement,
 ) -> Result<(), InvariantError> {
@@ -115,20 +118,25 @@ pub fn certify_candidate_embedded(
     };
     let mut in_patch = patch_faces.to_vec();
     in_patch.sort_unstable();
+    let meets = |f: usize| {
+        let t = work.mesh.triangles[f];
+        bbox_of(t.iter().map(|v| work.mesh.positions[v.idx()])).is_some_and(|(a, b)| {
+            (0..3).all(|k| a[k] <= hi[k] && b[k] >= lo[k])
+                && in_patch.binary_search(&FaceId::new(f)).is_err()
+        })
+    };
+    let scan = || -> Vec<usize> { (0..work.mesh.n_faces()).filter(|&f| meets(f)).collect() };
+    let old: Vec<usize> = match near.and_then(|n| n.faces_meeting(&work.mesh, topo, &lo, &hi)) {
+        Some(listed) => {
+            let found: Vec<usize> = listed.into_iter().filter(|&f| meets(f)).collect();
+            debug_assert_eq!(found, scan(), "the face index missed faces");
+            found
+        }
+        None => scan(),
+    };
     let n_new = new_tris.len();
     let mut tris = new_tris;
-    // One pass over the faces with a box test, and a small mesh of what is near: the run
-    // calls this for every candidate, so nothing here is proportional to the whole mesh but
-    // the scan itself.
-    for (f, t) in work.mesh.triangles.iter().enumerate() {
-        if let Some((a, b)) = bbox_of(t.iter().map(|v| work.mesh.positions[v.idx()])) {
-            if (0..3).all(|k| a[k] <= hi[k] && b[k] >= lo[k])
-                && in_patch.binary_search(&FaceId::new(f)).is_err()
-            {
-                tris.push(*t);
-            }
-        }
-    }
+    tris.extend(old.iter().map(|&f| work.mesh.triangles[f]));
     let mut local_id: HashMap<VertexId, VertexId> = HashMap::new();
     let mut positions = Vec::new();
     for t in &mut tris {
@@ -152,6 +160,107 @@ pub fn certify_candidate_embedded(
         Ok(())
     } else {
         Err(InvariantError::SelfIntersections(Offenders(pairs)))
+    }
+}
+
+/// Where the working mesh's triangles lie, for [`certify_candidate_embedded`] in Algorithm 1's
+/// loop: a uniform grid of triangle boxes, keyed by the triangles themselves (face ids shift
+/// at every stitch; a vertex never moves while patches are stitched, so a listed triangle that
+/// still exists is listed in every cell its box overlaps). Stitched faces are added
+/// ([`NearFaces::insert`]); removed ones stay listed and are dropped at the query, which finds
+/// each listed triangle's current face through the topology. Built again whenever vertices
+/// may have moved (before each pass of patches).
+pub struct NearFaces {
+    cell: f64,
+    cells: HashMap<[i64; 3], Vec<[VertexId; 3]>>,
+    /// Triangles whose box spans more than [`NearFaces::MAX_CELLS`] cells: always returned.
+    large: Vec<[VertexId; 3]>,
+    listed: usize,
+}
+
+impl NearFaces {
+    /// A triangle spanning more cells than this is kept in one list instead.
+    const MAX_CELLS: i64 = 64;
+
+    /// Index every face of `mesh`, with cells of twice its mean edge length.
+    pub fn new(mesh: &TriMesh) -> NearFaces {
+        let mut n = NearFaces {
+            cell: (2.0 * mesh.mean_edge_length()).max(1e-12),
+            cells: HashMap::new(),
+            large: Vec::new(),
+            listed: 0,
+        };
+        n.insert(mesh, (0..mesh.n_faces()).map(FaceId::new));
+        n
+    }
+
+    fn key(&self, p: &Point3<f64>) -> [i64; 3] {
+        [0, 1, 2].map(|k| (p[k] / self.cell).floor() as i64)
+    }
+
+    /// List the faces `faces` of `mesh` (just stitched).
+    pub fn insert(&mut self, mesh: &TriMesh, faces: impl Iterator<Item = FaceId>) {
+        for f in faces {
+            let t = mesh.triangles[f.idx()];
+            let Some((lo, hi)) = bbox_of(t.iter().map(|v| mesh.positions[v.idx()])) else {
+                continue;
+            };
+            let (a, b) = (self.key(&lo), self.key(&hi));
+            let span = (0..3).map(|k| b[k] - a[k] + 1).product::<i64>();
+            self.listed += 1;
+            if span > Self::MAX_CELLS {
+                self.large.push(t);
+                continue;
+            }
+            for i in a[0]..=b[0] {
+                for j in a[1]..=b[1] {
+                    for k in a[2]..=b[2] {
+                        self.cells.entry([i, j, k]).or_default().push(t);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The current faces whose listed box may meet `lo..hi`, sorted; `None` when the box spans
+    /// so many cells that a scan of the faces is cheaper.
+    pub fn faces_meeting(
+        &self,
+        mesh: &TriMesh,
+        topo: &Topology,
+        lo: &Point3<f64>,
+        hi: &Point3<f64>,
+    ) -> Option<Vec<usize>> {
+        let (a, b) = (self.key(lo), self.key(hi));
+        let span = (0..3).map(|k| (b[k] - a[k] + 1) as f64).product::<f64>();
+        if span > (self.listed.max(mesh.n_faces()) / 4) as f64 {
+            return None;
+        }
+        let mut out = Vec::new();
+        let mut add = |t: &[VertexId; 3]| {
+            if let Some(f) = topo
+                .vertex_faces(t[0])
+                .iter()
+                .find(|f| mesh.triangles[f.idx()] == *t)
+            {
+                out.push(f.idx());
+            }
+        };
+        for t in &self.large {
+            add(t);
+        }
+        for i in a[0]..=b[0] {
+            for j in a[1]..=b[1] {
+                for k in a[2]..=b[2] {
+                    for t in self.cells.get(&[i, j, k]).into_iter().flatten() {
+                        add(t);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        Some(out)
     }
 }
 
@@ -362,7 +471,7 @@ mod tests {
                         .collect(),
                     ..Replacement::default()
                 };
-                let full = certify_candidate_embedded(&work, &fan, &r).is_ok();
+                let full = certify_candidate_embedded(&work, &topo, None, &fan, &r).is_ok();
                 let local = candidate_embedded_local(&work.mesh, &grid, &fan, &new_tris);
                 assert_eq!(full, local, "v{vi} t {t}");
                 if full {
@@ -377,5 +486,47 @@ mod tests {
             hits > 0 && misses > 0,
             "both verdicts exercised: {hits} / {misses}"
         );
+    }
+
+    /// With the face index the candidate certificate gives the scan's verdict, naming the same
+    /// pairs: a torus vertex's fan around a new vertex pushed through the far wall of the tube
+    /// (intersecting) or moved a little (not).
+    #[test]
+    fn the_face_index_finds_what_the_scan_finds() {
+        let torus = crate::mesh::generators::torus(1.0, 0.3, 24, 12);
+        let work = WorkingMesh::from_reference(&torus);
+        let topo = Topology::build(&work.mesh);
+        let near = NearFaces::new(&work.mesh);
+        let (mut hits, mut misses) = (0, 0);
+        for vi in (0..work.mesh.n_vertices()).step_by(5) {
+            let v = VertexId::new(vi);
+            let fan = topo.vertex_faces(v).to_vec();
+            let old = work.mesh.positions[vi];
+            let centre = Point3::from(Vector3::new(old.x, old.y, 0.0).normalize());
+            for t in [0.05, 2.5] {
+                let r = Replacement {
+                    new_positions: vec![old + (centre - old) * t],
+                    new_locations: vec![work.locations[vi]],
+                    new_curve: Vec::new(),
+                    triangles: fan
+                        .iter()
+                        .map(|f| {
+                            work.mesh.triangles[f.idx()].map(|u| match u == v {
+                                true => PatchVertex::New(0),
+                                false => PatchVertex::Existing(u),
+                            })
+                        })
+                        .collect(),
+                };
+                let scan = certify_candidate_embedded(&work, &topo, None, &fan, &r);
+                let indexed = certify_candidate_embedded(&work, &topo, Some(&near), &fan, &r);
+                assert_eq!(scan, indexed, "v{vi} t {t}");
+                match scan {
+                    Ok(()) => misses += 1,
+                    Err(_) => hits += 1,
+                }
+            }
+        }
+        assert!(hits > 0 && misses > 0, "{hits} / {misses}");
     }
 }

@@ -190,6 +190,10 @@ pub struct LoopState {
     /// `blocked[f]` while a batch is chosen: face `f` shares a vertex with a patch already in
     /// the batch ([`PatchContext::blocked`]); empty between batches.
     pub blocked: Vec<bool>,
+    /// Where the working mesh's faces lie, for the candidates' self-intersection certificate
+    /// (when the input is embedded); built again before each pass of patches
+    /// ([`LoopState::index_faces`]).
+    pub near: Option<crate::invariants::NearFaces>,
 }
 
 /// Per-stage times and certificate counts of a run.
@@ -275,6 +279,7 @@ impl LoopState {
             fallbacks: Fallbacks::default(),
             improvement: None,
             blocked: Vec::new(),
+            near: None,
             work,
             topo,
             features,
@@ -352,6 +357,14 @@ impl LoopState {
                 }
             }
         }
+    }
+
+    /// Index the working mesh's faces for the candidates' certificate (vertices may have moved
+    /// since the last index: the surface passes move them in place).
+    pub fn index_faces(&mut self, ctx: &RunContext<'_>) {
+        self.near = ctx
+            .embedded_input
+            .then(|| crate::invariants::NearFaces::new(&self.work.mesh));
     }
 
     /// The feature-line pieces, when there are any.

@@ -102,6 +102,7 @@ fn patch_pass(
     // The surface passes before this one flip edges without keeping the loop's topology in
     // step: the strategy must not grow patches on a stale one.
     state.topo = crate::mesh::Topology::build(&state.work.mesh);
+    state.index_faces(ctx);
     state.work.processed = targets.iter().map(|t| !t).collect();
     while state.work.unprocessed() > 0 {
         if budget.is_some_and(|b| pass.patches >= b) {

@@ -79,6 +79,7 @@ pub fn remesh(
     let plan = Plan::resolve(field, &topo, options)?;
     let ctx = RunContext::new(plan.quality_field(field), topo, &plan, stages);
     let mut state = LoopState::new(&ctx)?;
+    state.index_faces(&ctx);
     let mut rng = crate::Rng::seed_from_u64(plan.options.seed);
     while state.face_remains(&ctx) {
         let batch = next_batch(&ctx, &mut state, &mut rng)?; // (a) Sec. 3.2, a vertex apart

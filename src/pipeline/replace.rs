@@ -236,6 +236,9 @@ fn certify_after_batch(
     if !removed.is_empty() {
         state.topo = state.topo.after_replacing(&state.work.mesh, removed);
     }
+    if let Some(near) = &mut state.near {
+        near.insert(&state.work.mesh, new_faces.iter().copied());
+    }
     let (work, topo) = (&state.work, &state.topo);
     let fail = |e: InvariantError| PipelineError::Certificate {
         patch: pid,

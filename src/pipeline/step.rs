@@ -154,6 +154,7 @@ pub fn patch_step(
         let view = PatchView {
             work: &state.work,
             topo: &state.topo,
+            near: state.near.as_ref(),
             factors: &state.factors,
             refine: !state.over_face_budget,
         };
@@ -251,6 +252,7 @@ fn certify_patch(
 struct PatchView<'a> {
     work: &'a WorkingMesh,
     topo: &'a Topology,
+    near: Option<&'a crate::invariants::NearFaces>,
     factors: &'a VertexFactors,
     /// The fidelity control may refine (false once the run is over its face budget).
     refine: bool,
@@ -393,8 +395,13 @@ fn attempt(
     counters.cert.no_flips += 1;
     if ctx.embedded_input {
         let t0 = Instant::now();
-        let checked =
-            invariants::certify_candidate_embedded(view.work, faces, &refined.replacement);
+        let checked = invariants::certify_candidate_embedded(
+            view.work,
+            view.topo,
+            view.near,
+            faces,
+            &refined.replacement,
+        );
         counters.times.certify += t0.elapsed().as_secs_f64();
         if let Err(e) = checked {
             return Err(AttemptFailure::lifted(e, refined.replacement));
