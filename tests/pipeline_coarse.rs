@@ -220,3 +220,66 @@ fn a_run_over_its_face_budget_stops_refining_and_ends_ok_with_a_warning() {
     assert!(bounded.report.certificate.no_self_intersections == 1);
     assert!(w.1 < bounded.report.faces_out, "the budget was exceeded");
 }
+
+/// The work budget (issue 20: a run's cost bounded by a count, never a hang): past it no
+/// patch is refined, no further sweep starts and the improvers are skipped; past twice it no
+/// further patch starts and the faces not reached stay as they were. Both runs end `Ok`,
+/// certified, with the warning; without a budget in reach neither happens.
+#[test]
+fn a_run_over_its_work_budget_ends_ok_with_a_warning() {
+    use conemesh::pipeline::Warning;
+    let field = unit_field(&generators::torus(1.0, 0.3, 24, 10));
+    let mut options = RemeshOptions {
+        sweeps: 3,
+        coarse_input: CoarseInput::Off,
+        ..RemeshOptions::default()
+    };
+    options.fidelity.max_deviation = 0.0005; // every patch wants its extra rounds
+    let work_warning = |r: &conemesh::pipeline::RemeshResult| {
+        r.report.warnings.iter().find_map(|w| match *w {
+            Warning::WorkBudget {
+                patches,
+                work,
+                budget,
+                stopped,
+                unprocessed,
+            } => Some((patches, work, budget, stopped, unprocessed)),
+            _ => None,
+        })
+    };
+    let free = remesh(&field, &Stages::default(), &options, |_| {}).expect("runs");
+    assert!(work_warning(&free).is_none());
+    // The budget's base (the larger of the input's and the expected output's face count),
+    // read off the warning of a budget of 1.
+    options.work_budget = 1.0;
+    let base = work_warning(&remesh(&field, &Stages::default(), &options, |_| {}).expect("runs"))
+        .expect("over a budget of 1")
+        .2 as f64;
+    assert!(base >= 480.0, "{base}");
+    let improver_patches = |r: &conemesh::pipeline::RemeshResult| {
+        r.report.improvement.as_ref().map_or(0, |i| {
+            i.steps.iter().map(|s| s.counts.patches).sum::<usize>()
+        })
+    };
+    let improved = |r: &conemesh::pipeline::RemeshResult| improver_patches(r) > 0;
+    assert!(improved(&free), "the improvers ran");
+
+    // Over the budget after about a sweep's work: no refinement after it, no improver.
+    options.work_budget = free.report.work as f64 / base / 4.0;
+    let over = remesh(&field, &Stages::default(), &options, |_| {}).expect("runs");
+    let (patches, work, budget, stopped, _) = work_warning(&over).expect("the warning");
+    assert!(work > budget && !stopped, "{work} {budget}");
+    let records = &over.report.patch_records;
+    assert!(records[patches..].iter().all(|p| p.fidelity_rounds == 0));
+    assert!(!improved(&over), "the improvers were skipped");
+    assert!(over.report.patches < free.report.patches);
+    assert_eq!(over.report.certificate.no_self_intersections, 1);
+
+    // Twice over it within the first sweep: patches stop, faces are kept, still certified.
+    options.work_budget = 0.02;
+    let stop = remesh(&field, &Stages::default(), &options, |_| {}).expect("runs");
+    let (_, _, _, stopped, unprocessed) = work_warning(&stop).expect("the warning");
+    assert!(stopped && unprocessed > 0, "{unprocessed}");
+    assert_eq!(stop.report.certificate.no_self_intersections, 1);
+    assert!(stop.report.patches < over.report.patches);
+}

@@ -179,6 +179,11 @@ pub struct LoopState {
     pub over_face_budget: bool,
     /// (patches, faces) when it did.
     pub over_face_budget_at: Option<(usize, usize)>,
+    /// Over the work budget: patches made and work done when it happened
+    /// ([`LoopState::note_work_budget`]).
+    pub over_work_budget_at: Option<(usize, usize)>,
+    /// Over twice the work budget: no further patch starts.
+    pub work_stopped: bool,
     /// Times and certificate counts.
     pub counters: Counters,
     /// Per-patch records.
@@ -203,6 +208,8 @@ pub struct Counters {
     pub times: StageTimes,
     /// Certificates checked and held.
     pub cert: Certificate,
+    /// Faces handled by patch attempts ([`super::RemeshOptions::work_budget`]).
+    pub work: usize,
 }
 
 impl Counters {
@@ -211,6 +218,7 @@ impl Counters {
     pub fn absorb(&mut self, other: Counters) {
         self.times.add(&other.times);
         self.cert.add(&other.cert);
+        self.work += other.work;
     }
 }
 
@@ -274,6 +282,8 @@ impl LoopState {
             budget_exhausted: false,
             over_face_budget: false,
             over_face_budget_at: None,
+            over_work_budget_at: None,
+            work_stopped: false,
             counters: Counters::default(),
             records: Vec::new(),
             fallbacks: Fallbacks::default(),
@@ -293,7 +303,7 @@ impl LoopState {
     pub fn face_remains(&mut self, ctx: &RunContext<'_>) -> bool {
         let o = &ctx.plan.options;
         if self.work.unprocessed() == 0 {
-            if self.sweep >= o.sweeps || self.over_face_budget {
+            if self.sweep >= o.sweeps || self.over_face_budget || self.over_work_budget() {
                 return false;
             }
             // A further sweep (our addition): the new patches' fixed boundaries run through
@@ -306,7 +316,33 @@ impl LoopState {
             self.budget_exhausted = true;
             return false;
         }
-        true
+        !self.work_stopped
+    }
+
+    /// The work budget in faces handled: [`super::RemeshOptions::work_budget`] times the
+    /// face budget's base.
+    pub fn work_budget(&self, ctx: &RunContext<'_>) -> f64 {
+        let base = ctx.plan.expected_fidelity.max(self.faces_per_sweep as f64);
+        ctx.plan.options.work_budget * base
+    }
+
+    /// Whether the run is over its work budget (no refinement, no further sweep, no improver
+    /// patch pass).
+    pub fn over_work_budget(&self) -> bool {
+        self.over_work_budget_at.is_some()
+    }
+
+    /// Note whether the work done is over the run's work budget, and over twice it (then no
+    /// further patch starts). The count, unlike a clock, is the same on every machine and
+    /// thread count, so the output still depends on the seed only.
+    pub fn note_work_budget(&mut self, ctx: &RunContext<'_>) {
+        let (work, budget) = (self.counters.work, self.work_budget(ctx));
+        if !self.over_work_budget() && work as f64 > budget {
+            self.over_work_budget_at = Some((self.patches, work));
+        }
+        if work as f64 > 2.0 * budget {
+            self.work_stopped = true;
+        }
     }
 
     /// Note whether the working mesh is over the run's face budget:

@@ -198,6 +198,15 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
                 as usize,
         });
     }
+    if let Some((patches, work)) = state.over_work_budget_at {
+        warnings.push(Warning::WorkBudget {
+            patches,
+            work,
+            budget: state.work_budget(ctx) as usize,
+            stopped: state.work_stopped,
+            unprocessed: state.work.unprocessed(),
+        });
+    }
     if state.budget_exhausted {
         warnings.push(Warning::PatchBudget {
             patches: state.patches,
@@ -244,6 +253,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
         patches: state.patches,
         loop_patches: state.loop_patches,
         loop_batches: state.batches,
+        work: state.counters.work,
         budget_exhausted: state.budget_exhausted,
         times: state.counters.times,
         certificate: state.counters.cert,

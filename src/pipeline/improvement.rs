@@ -90,7 +90,7 @@ fn patch_pass(
         .options
         .max_patches
         .map(|m| m.saturating_sub(state.patches));
-    if state.budget_exhausted || run_left == Some(0) {
+    if state.budget_exhausted || state.over_work_budget() || run_left == Some(0) {
         pass.budget_exhausted = true;
         return Ok(pass);
     }
@@ -105,7 +105,8 @@ fn patch_pass(
     state.index_faces(ctx);
     state.work.processed = targets.iter().map(|t| !t).collect();
     while state.work.unprocessed() > 0 {
-        if budget.is_some_and(|b| pass.patches >= b) {
+        state.note_work_budget(ctx);
+        if budget.is_some_and(|b| pass.patches >= b) || state.over_work_budget() {
             pass.budget_exhausted = true;
             break;
         }

@@ -44,7 +44,7 @@ mod step;
 pub use error::{PipelineError, Stage, StageError};
 pub use options::{
     default_improvers, Cancel, CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO,
-    DEFAULT_BATCH, DEFAULT_IMPROVERS, DENSE_INPUT_RATIO, FACE_BUDGET,
+    DEFAULT_BATCH, DEFAULT_IMPROVERS, DENSE_INPUT_RATIO, FACE_BUDGET, WORK_BUDGET,
 };
 pub use records::{
     AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,
@@ -86,6 +86,7 @@ pub fn remesh(
         let outcomes = step::batch_steps(&ctx, &state, &batch, &mut rng)?; // (b)-(e), at the same time
         replace::replace_batch(&ctx, &mut state, outcomes)?; // replace each P, update M
         state.note_face_budget(&ctx); // past it, no more refinement: the run's cost is bounded
+        state.note_work_budget(&ctx); // past it, no refinement and then no further patch
         state.batches += 1;
         on_progress(state.progress(&ctx));
         options.cancel.check(state.patches)?;

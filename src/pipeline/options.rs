@@ -90,6 +90,13 @@ pub struct RemeshOptions {
     /// output (default [`FACE_BUDGET`]); past it the fidelity control stops refining and no
     /// further sweep starts (a warning, not an error).
     pub face_budget: f64,
+    /// The work budget, in faces handled by patch attempts (each attempt's patch faces plus
+    /// its candidate's faces, once per fidelity round), as a multiple of the same base as the
+    /// face budget (default [`WORK_BUDGET`]). Past it the fidelity control stops refining, no
+    /// further sweep starts and the improvers' patch passes (Algorithm 2) stop; past twice it
+    /// no further patch of the loop starts and the faces not reached are kept as they were.
+    /// Both end `Ok` with [`Warning::WorkBudget`](super::Warning::WorkBudget).
+    pub work_budget: f64,
     /// Asks a running job to stop (e.g. Ctrl-C in the Python package); not an option of the
     /// result, so it is not reported. Default: never set.
     #[serde(skip)]
@@ -134,6 +141,13 @@ pub const DEFAULT_BATCH: usize = 1;
 /// 1× except decimated-knight under the coarse-input profile (9×); a CAD part whose creases
 /// no feature line follows reached 13× after 20 of its patches and ran past 5 minutes.
 pub const FACE_BUDGET: f64 = 12.0;
+
+/// The work budget of a run ([`RemeshOptions::work_budget`]): faces handled by patch attempts,
+/// as a multiple of the larger of the input's face count and the expected output. With the
+/// per-patch certificates local, a run's time follows this count; the shared meshes and the
+/// CGAL corpus stay far below it (BENCHMARKS.md, "Work"), so it only stops runs that would
+/// otherwise go on for many minutes.
+pub const WORK_BUDGET: f64 = 400.0;
 
 /// [`CoarseInput::Auto`] runs the coarse-input profile when the a-priori fidelity scaling
 /// multiplies the expected output face count ([`super::expected_faces`]) by at least this much.
@@ -180,6 +194,7 @@ impl Default for RemeshOptions {
             sizes: SizeOptions::default(),
             batch: DEFAULT_BATCH,
             face_budget: FACE_BUDGET,
+            work_budget: WORK_BUDGET,
             cancel: Cancel::default(),
         }
     }
@@ -206,6 +221,12 @@ impl RemeshOptions {
     pub fn validate(&self) -> Result<(), String> {
         if self.batch == 0 {
             return Err("the patch batch must hold at least 1 patch".to_string());
+        }
+        if self.work_budget.is_nan() || self.work_budget <= 0.0 {
+            return Err(format!(
+                "work budget {} is not a number > 0",
+                self.work_budget
+            ));
         }
         if self.face_budget.is_nan() || self.face_budget <= 0.0 {
             return Err(format!(

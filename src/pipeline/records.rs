@@ -244,6 +244,21 @@ pub enum Warning {
         /// the budget
         budget: usize,
     },
+    /// The run went over its work budget ([`super::WORK_BUDGET`]): from then on the fidelity
+    /// control did not refine, no further sweep started and the improvers' patch passes
+    /// stopped; past twice the budget no further patch of the loop started.
+    WorkBudget {
+        /// patches made when it happened
+        patches: usize,
+        /// faces handled by patch attempts then
+        work: usize,
+        /// the budget
+        budget: usize,
+        /// whether the run went past twice the budget and stopped starting patches
+        stopped: bool,
+        /// faces no patch reached (kept as they were)
+        unprocessed: usize,
+    },
     /// The coarse-input profile ran ([`RemeshOptions::coarse_profile`]).
     CoarseProfile {
         /// `--coarse on` forced it (else the automatic rule chose it)
@@ -286,6 +301,28 @@ impl fmt::Display for Warning {
                 "the patch budget ran out after {patches} patches: {unprocessed} face(s) were \
                  not reached and are kept as they were"
             ),
+            Warning::WorkBudget {
+                patches,
+                work,
+                budget,
+                stopped,
+                unprocessed,
+            } => {
+                write!(
+                    f,
+                    "the run went over its work budget ({work} faces handled by patch attempts \
+                     after {patches} patches, budget {budget}): from then on the fidelity control \
+                     stopped refining, no further sweep ran and the improvers' patch passes stopped"
+                )?;
+                match stopped {
+                    true => write!(
+                        f,
+                        "; past twice the budget no further patch started and {unprocessed} \
+                         face(s) were kept as they were"
+                    ),
+                    false => Ok(()),
+                }
+            }
             Warning::ImproverBudget { improver, patches } => write!(
                 f,
                 "improver `{improver}` ran out of its budget after {patches} patches; the faces \
@@ -442,6 +479,9 @@ pub struct RemeshReport {
     /// The batches they came in ([`RemeshOptions::batch`]): with several threads, the patches
     /// of a batch ran at the same time.
     pub loop_batches: usize,
+    /// Faces handled by patch attempts, the loop's and the improvers'
+    /// ([`RemeshOptions::work_budget`]).
+    pub work: usize,
     /// The patch budget ([`RemeshOptions::max_patches`]) ran out before every face was
     /// processed.
     pub budget_exhausted: bool,

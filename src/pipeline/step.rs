@@ -156,10 +156,12 @@ pub fn patch_step(
             topo: &state.topo,
             near: state.near.as_ref(),
             factors: &state.factors,
-            refine: !state.over_face_budget,
+            refine: !state.over_face_budget && !state.over_work_budget(),
         };
+        log.counters.work += faces.len();
         match attempt(ctx, &view, &faces, rng, &mut log.counters) {
             Ok((refined, distortion)) => {
+                log.counters.work += refined.replacement.triangles.len() * (1 + refined.rounds);
                 let record = record(
                     refined.replacement.triangles.len(),
                     false,
