@@ -329,3 +329,48 @@ fn a_cad_can_keeps_its_rims_at_the_defaults() {
         "without feature lines the rims are {d_off} away"
     );
 }
+
+/// A zero-area face on a crease (CGAL's `mpi.off` has two, from fan-triangulated polygons)
+/// is not a crease and not the feature-line stage's doing: the run at the defaults remeshes
+/// it away instead of failing the certificate after the resampling (issue 20).
+#[test]
+fn a_zero_area_input_face_on_a_crease_does_not_fail_the_resampling() {
+    let mut m = generators::cube(4);
+    // An edge of the cube along x at y = z = 0, split at its midpoint: its face becomes two,
+    // and the zero-area face [a, b, mid] closes the surface against the face across.
+    let on_axis = |v: conemesh::VertexId| {
+        let p = m.positions[v.idx()];
+        p.y == 0.0 && p.z == 0.0
+    };
+    let (f, i) = (0..m.n_faces())
+        .flat_map(|f| (0..3).map(move |i| (f, i)))
+        .find(|&(f, i)| {
+            let t = m.triangles[f];
+            on_axis(t[i]) && on_axis(t[(i + 1) % 3])
+        })
+        .expect("a face on the crease");
+    let t = m.triangles[f];
+    let (a, b, c) = (t[i], t[(i + 1) % 3], t[(i + 2) % 3]);
+    let mid = conemesh::VertexId::new(m.n_vertices());
+    m.positions.push(nalgebra::center(
+        &m.positions[a.idx()],
+        &m.positions[b.idx()],
+    ));
+    m.triangles[f] = [a, mid, c];
+    m.triangles.push([mid, b, c]);
+    m.triangles.push([a, b, mid]);
+    assert_eq!(conemesh::invariants::degenerate_faces(&m).len(), 1);
+    assert!(Topology::build(&m).is_oriented_manifold());
+    let out = remesh(
+        &field(&m),
+        &Stages::default(),
+        &RemeshOptions::default(),
+        |_| {},
+    )
+    .expect("remeshed at the defaults");
+    assert!(
+        out.report.feature_edges > 0,
+        "the cube's creases were found"
+    );
+    assert!(conemesh::invariants::degenerate_faces(&out.mesh).is_empty());
+}

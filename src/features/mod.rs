@@ -347,11 +347,17 @@ pub fn sharp_edges(mesh: &TriMesh, topo: &Topology, angle_deg: f64) -> Vec<EdgeK
             if g <= f {
                 continue;
             }
-            let (n1, n2) = (mesh.face_normal_raw(f), mesh.face_normal_raw(g));
-            let (l1, l2) = (n1.norm(), n2.norm());
-            if l1 == 0.0 || l2 == 0.0 {
+            // A zero-area face (decided exactly: its float normal may be round-off of any
+            // direction) has no dihedral angle; its edges are no crease.
+            let flat = |h: FaceId| {
+                let [a, b, c] = mesh.face_points(h);
+                crate::predicates::collinear3d(&a, &b, &c)
+            };
+            if flat(f) || flat(g) {
                 continue;
             }
+            let (n1, n2) = (mesh.face_normal_raw(f), mesh.face_normal_raw(g));
+            let (l1, l2) = (n1.norm(), n2.norm());
             if n1.dot(&n2) / (l1 * l2) < cos_max {
                 out.push(EdgeKey::new(t[i], t[(i + 1) % 3]));
             }

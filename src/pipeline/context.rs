@@ -259,7 +259,7 @@ impl LoopState {
                 let (live, _) = work.mesh.without_unreferenced_vertices();
                 invariants::certify_manifold(&work.mesh, &topo)
                     .and_then(|()| invariants::certify_oriented(&work.mesh, &topo))
-                    .and_then(|()| invariants::certify_no_degenerate_faces(&work.mesh))
+                    .and_then(|()| no_new_degenerate_face(reference, &work.mesh))
                     .and_then(|()| invariants::certify_same_topology(reference, &live))
                     .map_err(PipelineError::FeatureLines)?;
                 topo
@@ -416,5 +416,28 @@ impl LoopState {
             unprocessed: self.work.unprocessed() + (sweeps - self.sweep) * self.faces_per_sweep,
             total: ctx.total_faces(self.faces_per_sweep),
         }
+    }
+}
+
+/// No face of `work` has exactly zero area unless it is a face of the input unchanged (same
+/// corners, same order): a zero-area input face is the loop's to remesh, not the feature-line
+/// stage's doing.
+fn no_new_degenerate_face(
+    reference: &crate::mesh::TriMesh,
+    work: &crate::mesh::TriMesh,
+) -> Result<(), invariants::InvariantError> {
+    let input: HashSet<[VertexId; 3]> = invariants::degenerate_faces(reference)
+        .into_iter()
+        .map(|f| reference.triangles[f.idx()])
+        .collect();
+    let new: Vec<crate::ids::FaceId> = invariants::degenerate_faces(work)
+        .into_iter()
+        .filter(|f| !input.contains(&work.triangles[f.idx()]))
+        .collect();
+    match new.is_empty() {
+        true => Ok(()),
+        false => Err(invariants::InvariantError::DegenerateFaces(
+            invariants::Offenders(new),
+        )),
     }
 }

@@ -131,14 +131,14 @@ pub enum PipelineError {
     /// The working mesh failed its certificate after the feature lines were resampled, before
     /// the loop.
     #[error("after resampling the feature lines: {0}")]
-    FeatureLines(#[source] InvariantError),
+    FeatureLines(InvariantError),
     /// The final mesh self-intersects.
     #[error("final mesh: {0}")]
-    Final(#[source] InvariantError),
+    Final(InvariantError),
     /// The output mapped back to file units failed its exact re-certification (rounding of
     /// the new vertices).
     #[error("the output in file units (after mapping back from unit space): {0}")]
-    FileUnits(#[source] InvariantError),
+    FileUnits(InvariantError),
     /// The strategy returned a patch without an unprocessed face (the loop would not end).
     #[error(
         "patch {patch} (seed {seed}) contains no unprocessed face; the strategy must make progress"
