@@ -172,6 +172,19 @@ fn a_target_too_small_for_the_input_is_refused_up_front() {
     assert!(coarse_input_estimate(&f, &RemeshOptions::default()).is_ok());
 }
 
+/// A torus whose every patch wants extra fidelity rounds, over three sweeps: the budgets'
+/// test case.
+fn refining_torus() -> (MetricField, RemeshOptions) {
+    let field = unit_field(&generators::torus(1.0, 0.3, 24, 10));
+    let mut options = RemeshOptions {
+        sweeps: 3,
+        coarse_input: CoarseInput::Off,
+        ..RemeshOptions::default()
+    };
+    options.fidelity.max_deviation = 0.0005;
+    (field, options)
+}
+
 /// The face budget (issue 20: a CAD part whose creases no feature line follows ran past five
 /// minutes while the fidelity control kept refining): once the working mesh outgrows it, no
 /// patch is refined and no further sweep starts, and the run ends `Ok`, certified, with the
@@ -179,13 +192,7 @@ fn a_target_too_small_for_the_input_is_refused_up_front() {
 #[test]
 fn a_run_over_its_face_budget_stops_refining_and_ends_ok_with_a_warning() {
     use conemesh::pipeline::Warning;
-    let field = unit_field(&generators::torus(1.0, 0.3, 24, 10));
-    let mut options = RemeshOptions {
-        sweeps: 3,
-        coarse_input: CoarseInput::Off,
-        ..RemeshOptions::default()
-    };
-    options.fidelity.max_deviation = 0.0005; // every patch wants its extra rounds
+    let (field, mut options) = refining_torus();
     let free = remesh(&field, &Stages::default(), &options, |_| {}).expect("runs");
     assert!(free
         .report
@@ -228,13 +235,7 @@ fn a_run_over_its_face_budget_stops_refining_and_ends_ok_with_a_warning() {
 #[test]
 fn a_run_over_its_work_budget_ends_ok_with_a_warning() {
     use conemesh::pipeline::Warning;
-    let field = unit_field(&generators::torus(1.0, 0.3, 24, 10));
-    let mut options = RemeshOptions {
-        sweeps: 3,
-        coarse_input: CoarseInput::Off,
-        ..RemeshOptions::default()
-    };
-    options.fidelity.max_deviation = 0.0005; // every patch wants its extra rounds
+    let (field, mut options) = refining_torus();
     let work_warning = |r: &conemesh::pipeline::RemeshResult| {
         r.report.warnings.iter().find_map(|w| match *w {
             Warning::WorkBudget {

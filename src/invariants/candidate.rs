@@ -103,16 +103,7 @@ pub fn certify_candidate_embedded(
         Some(i) => r.new_positions[i as usize],
         None => work.mesh.positions[v.idx()],
     };
-    let new_tris: Vec<[VertexId; 3]> = r
-        .triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| match v {
-                PatchVertex::Existing(g) => g,
-                PatchVertex::New(i) => VertexId(base + i),
-            })
-        })
-        .collect();
+    let new_tris = numbered_triangles(r, base);
     let Some((lo, hi)) = bbox_of(new_tris.iter().flatten().map(|&v| position(v))) else {
         return Ok(());
     };
@@ -382,8 +373,13 @@ pub fn candidate_arrays(
     let mut positions = work.mesh.positions.clone();
     let base = positions.len() as u32;
     positions.extend_from_slice(&r.new_positions);
-    let triangles = r
-        .triangles
+    (positions, numbered_triangles(r, base))
+}
+
+/// The replacement's triangles with its new vertices numbered from `base` on (as stitching
+/// numbers them).
+fn numbered_triangles(r: &Replacement, base: u32) -> Vec<[VertexId; 3]> {
+    r.triangles
         .iter()
         .map(|t| {
             t.map(|v| match v {
@@ -391,8 +387,7 @@ pub fn candidate_arrays(
                 PatchVertex::New(i) => VertexId(base + i),
             })
         })
-        .collect();
-    (positions, triangles)
+        .collect()
 }
 
 /// Pairs `(j, k)`, `j < k`, of candidates (replacements of vertex-disjoint patches of the same
