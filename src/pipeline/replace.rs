@@ -167,6 +167,10 @@ pub fn replace_batch(
     }
     debug_assert_eq!(state.bound.len(), state.work.mesh.n_vertices());
     debug_assert_eq!(state.face_patch.len(), state.work.mesh.n_faces());
+    // The stitched faces join the face index (the kept ones are listed already).
+    if let Some(near) = &mut state.near {
+        near.insert(&state.work.mesh, new_faces.iter().flatten().copied());
+    }
     let all_new: Vec<FaceId> = new_faces.into_iter().flatten().chain(kept_faces).collect();
     touched.extend(
         all_new
@@ -235,9 +239,6 @@ fn certify_after_batch(
     // scratch, checked in debug builds); a batch that only kept faces changed nothing.
     if !removed.is_empty() {
         state.topo = state.topo.after_replacing(&state.work.mesh, removed);
-    }
-    if let Some(near) = &mut state.near {
-        near.insert(&state.work.mesh, new_faces.iter().copied());
     }
     let (work, topo) = (&state.work, &state.topo);
     let fail = |e: InvariantError| PipelineError::Certificate {
