@@ -171,3 +171,36 @@ fn user_metric_follows_the_file_vertex_order() {
     }
     assert!(matched > 0, "no input vertex survived to compare");
 }
+
+/// A proptest-mutated file (the CI run that was killed after 83 minutes) read as a small
+/// icosphere with one coordinate replaced by a huge value (1.8e19 from a text token, 4.1e30
+/// and 3.4e55 from binary byte edits). In unit space the sphere is then 1e-19 to 1e-55 across,
+/// and a patch's transferred metric asked for 1e22 faces (LCT refined until memory ran out),
+/// or one direction was so fine that the splits never stopped, or a boundary chain was cut
+/// into 1e20 pieces. Each run now ends: a patch over the run's face budget is a failed
+/// attempt (`Remesh2dError::TooDense`) and its faces are kept, every certificate holds.
+#[test]
+fn an_input_with_one_vertex_at_1e19_to_1e55_ends_certified() {
+    use conemesh::pipeline::Remesher;
+    use rand::SeedableRng;
+    let base = conemesh::mesh::generators::icosphere(1.0, 1);
+    let base =
+        conemesh::mesh::generators::perturb(&base, 0.01, &mut conemesh::Rng::seed_from_u64(1));
+    for (v, far) in [
+        (26usize, -4.139726497495104e30),
+        (0, 1.8446744073709552e19),
+        (13, 3.39923e55),
+    ] {
+        let mut m = base.clone();
+        m.positions[v].x = far;
+        let r = Remesher::new(RemeshOptions::default())
+            .run(&m)
+            .unwrap_or_else(|e| panic!("vertex {v} at x = {far:e}: {e}"));
+        let c = &r.unit.report.certificate;
+        assert!(
+            c.manifold > 0 && c.same_topology > 0,
+            "vertex {v} at {far:e}: {c:?}"
+        );
+        conemesh::invariants::certify_same_topology(&r.input, &r.mesh).expect("topology");
+    }
+}

@@ -223,3 +223,49 @@ fn a_grid_that_is_anisotropic_in_the_metric_leaves_no_lattice_behind() -> Result
     assert!(off <= 0.05, "{} faces for an ideal {ideal:.0}", q.n_faces);
     Ok(())
 }
+
+/// A metric many orders too fine for its domain is refused by name before any refinement:
+/// against LCT's own cap, and against the caller's in `remesh_bounded` (the pipeline's patch
+/// face cap). The split passes' own limit, for a metric whose area is small but one direction
+/// far too fine, is covered end to end by `an_input_with_one_vertex_at_1e19_to_1e55_ends_certified`
+/// in `tests/pipeline_regressions.rs`.
+#[test]
+fn a_metric_too_fine_for_its_domain_is_refused_not_refined_out_of_memory(
+) -> Result<(), Remesh2dError> {
+    struct Scaled(f64);
+    impl Metric2d for Scaled {
+        fn metric(&self, _: &Point2<f64>) -> Matrix2<f64> {
+            Matrix2::identity() * self.0
+        }
+    }
+    let dom = square_domain(&Iso, 0.25)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let unit = 3f64.sqrt() / 4.0 * 0.0625;
+    let ideal = conemesh::remesh2d::ideal_faces(&dom, &Iso, 0.25);
+    assert!((ideal - 1.0 / unit).abs() < 1e-9, "{ideal}");
+    // Area: 1e20 unit squares.
+    match Lct::default().remesh(&dom, &Scaled(1e20), 0.25, &mut rng) {
+        Err(Remesh2dError::TooDense { faces, max }) => {
+            assert!((faces - 1e20 / unit).abs() < 1e6, "{faces}");
+            assert_eq!(max, conemesh::remesh2d::MAX_LCT_FACES);
+        }
+        other => panic!("expected TooDense, got {other:?}"),
+    }
+    // 100 times the area: an ideal mesh has 1/unit·100 ≈ 3,695 faces, over a cap of 2,000.
+    match Lct::default().remesh_bounded(&dom, &Scaled(100.0), 0.25, 2000.0, &mut rng) {
+        Err(Remesh2dError::TooDense { faces, max }) => {
+            assert!(
+                (faces - 100.0 / unit).abs() < 1e-6 && max == 2000.0,
+                "{faces} {max}"
+            );
+        }
+        other => panic!("expected TooDense, got {other:?}"),
+    }
+    // Under the cap, a bounded remesh is the plain one.
+    let a = Lct::default().remesh(&dom, &Iso, 0.25, &mut ChaCha8Rng::seed_from_u64(3))?;
+    let b =
+        Lct::default().remesh_bounded(&dom, &Iso, 0.25, 1e4, &mut ChaCha8Rng::seed_from_u64(3))?;
+    assert_eq!(a.points, b.points);
+    assert_eq!(a.triangles, b.triangles);
+    Ok(())
+}

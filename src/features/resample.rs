@@ -165,9 +165,15 @@ fn piece_ends(len: &[f64], n: usize) -> Vec<End> {
 /// Most pieces per input edge of a chain (bounds the search for a fine enough resampling).
 const MAX_PIECES_PER_EDGE: usize = 64;
 
+/// Most pieces of one input edge longer than the target: far more than any run's output
+/// allows ([`crate::pipeline::MAX_EXPECTED_FACES`]), so only an input of wildly mixed scales
+/// (a vertex 1e19 away, say) reaches it, whose edge would otherwise be cut into pieces until
+/// memory runs out.
+const MAX_PIECES_PER_LONG_EDGE: usize = 1 << 14;
+
 /// The piece ends of `chain` (edge metric lengths `len`): when `round(S)` is at least the
-/// chain's edge count, every chain vertex and each edge cut into `round(length)` pieces;
-/// otherwise `round(S)` pieces (at least 3 on a closed chain), more while a piece's chord is farther than `max_deviation` (0: no bound)
+/// chain's edge count, every chain vertex and each edge cut into `round(length)` pieces (at
+/// most [`MAX_PIECES_PER_LONG_EDGE`]); otherwise `round(S)` pieces (at least 3 on a closed chain), more while a piece's chord is farther than `max_deviation` (0: no bound)
 /// from the chain vertices it replaces, so a curved crease keeps the distance tolerance
 /// the fidelity control asks of the faces.
 fn chain_ends(
@@ -187,7 +193,7 @@ fn chain_ends(
         // round(length) pieces, so the crease stays exactly the input's.
         return (0..len.len())
             .flat_map(|i| {
-                let k = (len[i].round() as usize).max(1);
+                let k = (len[i].round() as usize).clamp(1, MAX_PIECES_PER_LONG_EDGE);
                 let inner = (1..k).map(move |j| End::OnEdge(i, j as f64 / k as f64));
                 let vertex = (i + 1 < len.len()).then_some(End::Vertex(i + 1));
                 inner.chain(vertex)

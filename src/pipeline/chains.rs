@@ -68,6 +68,7 @@ pub fn patch_domain(
         metric,
         l_tar: ctx.plan.l_tar,
         eps: ctx.plan.eps,
+        max_pieces: ctx.plan.patch_face_cap(),
     };
     let chains = free_chains(&ctx.curves, work, topo, disk);
     if chains.is_empty() {
@@ -238,6 +239,9 @@ struct Sampler<'a> {
     metric: &'a dyn Metric2d,
     l_tar: f64,
     eps: f64,
+    /// More pieces than this (the patch face cap: a patch whose metric is many orders off for
+    /// its size) and the chain is not resampled.
+    max_pieces: f64,
 }
 
 impl Sampler<'_> {
@@ -284,6 +288,9 @@ impl Sampler<'_> {
             return None;
         }
         let closed = chain[0].0 == chain[chain.len() - 1].0;
+        if total / self.l_tar > self.max_pieces {
+            return None;
+        }
         let pieces = ((total / self.l_tar).round() as usize).max(if closed { 3 } else { 1 });
         // Arc length (and uv) at a metric length s along the chain.
         let at_metric = |s: f64| -> f64 {

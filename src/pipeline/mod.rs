@@ -51,7 +51,9 @@ pub use records::{
     PatchRecord, Progress, RemeshReport, RemeshResult, StageTimes, Warning,
 };
 pub use remesher::{Remeshed, Remesher};
-pub use sizing::{coarse_input_estimate, expected_faces, Plan, MAX_EXPECTED_FACES};
+pub use sizing::{
+    coarse_input_estimate, expected_faces, Plan, MAX_EXPECTED_FACES, MIN_PATCH_FACE_CAP,
+};
 pub use step::MIN_PATCH_FACES;
 
 use crate::mesh::Topology;

@@ -13,10 +13,16 @@ use nalgebra::Matrix3;
 /// Largest expected output ([`expected_faces`] in the metric at L_tar) a run accepts.
 pub const MAX_EXPECTED_FACES: f64 = 1e8;
 
+/// The floor of [`Plan::patch_face_cap`]'s base, so that a tiny input's patches are never
+/// capped near their legitimate size (LCT meshes a patch of this size in milliseconds).
+pub const MIN_PATCH_FACE_CAP: f64 = 1000.0;
+
 /// Everything a run derives from the input and the options before its first patch.
 pub struct Plan {
     /// The options the run uses: the caller's, or [`RemeshOptions::coarse_profile`] of them.
     pub options: RemeshOptions,
+    /// The input's face count.
+    pub faces_in: usize,
     /// Mean metric edge length of the input.
     pub l_avg: f64,
     /// Target metric edge length.
@@ -157,6 +163,7 @@ impl Plan {
             )
         };
         Ok(Plan {
+            faces_in: reference.n_faces(),
             eps: options.fidelity.max_deviation,
             options,
             l_avg,
@@ -170,6 +177,16 @@ impl Plan {
             sized,
             scaled,
         })
+    }
+
+    /// The most faces one patch's remesh may have: the whole run's face budget
+    /// ([`RemeshOptions::face_budget`] times the largest of the expected output with the
+    /// fidelity scaling, the input's face count and [`MIN_PATCH_FACE_CAP`]). No patch of a sane
+    /// run comes near it; a patch whose metric is many orders off for its domain stops there.
+    pub fn patch_face_cap(&self) -> f64 {
+        let faces_in = self.faces_in as f64;
+        let base = self.expected_fidelity.max(faces_in).max(MIN_PATCH_FACE_CAP);
+        self.options.face_budget * base
     }
 
     /// The run's metric: `input` with the size controls applied, when they are on.

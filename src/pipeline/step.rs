@@ -521,11 +521,25 @@ fn remesh_and_lift(
             let planar_field = transfer
                 .field(metrics, &base_trace)
                 .map_err(AttemptFailure::at(Stage::MetricTransfer))?;
+            // A patch whose metric asks for more faces than the whole run may have is refused
+            // before any remesher refines it out of memory (an input of wildly mixed scales).
+            let max = ctx.plan.patch_face_cap();
+            let faces = crate::remesh2d::ideal_faces(&domain.domain, &planar_field, ctx.plan.l_tar);
+            if faces > max {
+                let e = crate::remesh2d::Remesh2dError::TooDense { faces, max };
+                return Err(AttemptFailure::at(Stage::PlanarRemeshing)(e.into()));
+            }
             let planar = ctx
                 .stages
                 .remesher
-                .remesh(&domain.domain, &planar_field, ctx.plan.l_tar, rng)
-                .map_err(|e| AttemptFailure::at(Stage::PlanarRemeshing)(e.into()))?;
+                .remesh_bounded(&domain.domain, &planar_field, ctx.plan.l_tar, max, rng)
+                .map_err(|e| {
+                    // The faces made before the cap stopped it are work the budget counts.
+                    if let crate::remesh2d::Remesh2dError::TooDense { faces, .. } = e {
+                        counters.work += faces as usize;
+                    }
+                    AttemptFailure::at(Stage::PlanarRemeshing)(e.into())
+                })?;
             invariants::certify_planar(&domain.domain, &planar)
                 .map_err(|e| AttemptFailure::at(Stage::PlanarRemeshing)(e.into()))?;
             match round {

@@ -22,13 +22,14 @@ pub fn metric_length(metric: &dyn Metric2d, a: &Point2<f64>, b: &Point2<f64>, n:
 
 /// Subdivide every side of the closed polygon `corners` so that its pieces have metric length
 /// close to `target_length` (each side gets `max(1, round(len / target_length))` pieces at
-/// equal metric-length spacing, 64 samples per side). Corners are kept bit for bit, in order.
+/// equal metric-length spacing, 64 samples per side; at most 2^20 pieces). Corners are kept bit for bit, in order.
 pub fn resample_polygon(
     corners: &[Point2<f64>],
     metric: &dyn Metric2d,
     target_length: f64,
 ) -> Vec<Point2<f64>> {
     const SAMPLES: usize = 64;
+    const MAX_PIECES: usize = 1 << 20;
     let mut out = Vec::new();
     let n = corners.len();
     for i in 0..n {
@@ -47,7 +48,8 @@ pub fn resample_polygon(
         if !(total.is_finite() && target_length > 0.0) {
             continue;
         }
-        let pieces = ((total / target_length).round() as usize).max(1);
+        // Capped: a target many orders below the edge would exhaust memory.
+        let pieces = ((total / target_length).round() as usize).clamp(1, MAX_PIECES);
         for j in 1..pieces {
             let s = total * j as f64 / pieces as f64;
             let k = cum.partition_point(|&c| c < s).clamp(1, SAMPLES);

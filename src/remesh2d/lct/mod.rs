@@ -80,7 +80,30 @@ pub struct LctOptions {
     /// After split and collapse, bring the vertex count to that of an ideal mesh of the
     /// domain's metric area (default true), so edges have length L on average.
     pub density: bool,
+    /// The most faces a remesh may have (default [`MAX_LCT_FACES`]): a domain whose ideal
+    /// mesh ([`super::ideal_faces`]) has more is refused up front, and so is a result with
+    /// more. The rounds in between may overshoot, up to [`SPLIT_OVERSHOOT`] times the ideal
+    /// count and [`MAX_OVERSHOOT`] times this.
+    pub max_faces: f64,
 }
+
+/// [`LctOptions::max_faces`]' default: about a gigabyte of working mesh. A patch of the
+/// pipeline is far smaller; the pipeline refuses a patch over its own face budget first.
+pub const MAX_LCT_FACES: f64 = 4e6;
+
+/// How far the split passes may take a mesh past its base (the larger of the domain's ideal
+/// face count, its own face count and [`MIN_TRANSIENT_BASE`]) before LCT stops with
+/// [`Remesh2dError::TooDense`].
+pub const SPLIT_OVERSHOOT: f64 = 256.0;
+
+/// How far the split passes may take a mesh past [`LctOptions::max_faces`] (measured: 1.8×
+/// at the end of a round under the analytic suite's 1000:1 metric, where the pipeline's cap is
+/// 110k faces; a patch of a needle-shaped input went on to 11× and took 50 s).
+pub const MAX_OVERSHOOT: f64 = 4.0;
+
+/// The floor of the split passes' base: a domain of a few faces with a tiny ideal count may
+/// still grow this much (times [`SPLIT_OVERSHOOT`]) on its way.
+pub const MIN_TRANSIENT_BASE: f64 = 1000.0;
 
 impl Default for LctOptions {
     /// The settings for the curvature metric at L_tar = 1.5·L_avg (the paper's protocol, measured
@@ -104,6 +127,7 @@ impl Default for LctOptions {
             rebuild: false,
             start_spacing: 0.8,
             density: false,
+            max_faces: MAX_LCT_FACES,
         }
     }
 }
@@ -144,6 +168,21 @@ impl PlanarRemesher for Lct {
         rng: &mut ChaCha8Rng,
     ) -> Result<PlanarMesh, Remesh2dError> {
         remesh_planar(domain, metric, target_length, &self.options, rng)
+    }
+
+    fn remesh_bounded(
+        &self,
+        domain: &PlanarDomain,
+        metric: &dyn Metric2d,
+        target_length: f64,
+        max_faces: f64,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<PlanarMesh, Remesh2dError> {
+        let options = LctOptions {
+            max_faces: self.options.max_faces.min(max_faces),
+            ..self.options.clone()
+        };
+        remesh_planar(domain, metric, target_length, &options, rng)
     }
 }
 
@@ -271,6 +310,18 @@ pub fn remesh_planar(
     }
     certify_planar(domain, &identity(domain))
         .map_err(|e| Remesh2dError::InvalidDomain(e.to_string()))?;
+    let max = options.max_faces;
+    let ideal = super::ideal_faces(domain, metric, target_length);
+    if ideal > max {
+        return Err(Remesh2dError::TooDense { faces: ideal, max });
+    }
+    // Split passes overshoot the ideal count before the collapses bring it back (measured: up
+    // to 41× under the analytic suite's 1000:1 metric, and 21× at the end of a round); a mesh
+    // far past that is refining a metric too fine in one direction for its domain (its ideal
+    // count is small, its splits never stop).
+    let transient_base = ideal
+        .max(domain.triangles.len() as f64)
+        .max(MIN_TRANSIENT_BASE);
     let mut fixed = vec![false; domain.points.len()];
     for &b in &domain.boundary {
         fixed[b as usize] = true;
@@ -296,7 +347,13 @@ pub fn remesh_planar(
         let mut w = Work::new(&mesh, metric, target_length, &fixed, &locked, options)?;
         if round < options.rounds {
             for _ in 0..options.max_passes {
-                if w.split_pass() == 0 {
+                let split = w.split_pass();
+                // A disk with V vertices has fewer than 2V faces.
+                let faces = 2.0 * w.vertex_count() as f64;
+                if faces > (SPLIT_OVERSHOOT * transient_base).min(MAX_OVERSHOOT * max) {
+                    return Err(Remesh2dError::TooDense { faces, max });
+                }
+                if split == 0 {
                     break;
                 }
             }
@@ -336,7 +393,11 @@ pub fn remesh_planar(
             certify_planar(domain, &mesh)?;
         }
     }
-    Ok(mesh)
+    let faces = mesh.triangles.len() as f64;
+    match faces > max {
+        true => Err(Remesh2dError::TooDense { faces, max }),
+        false => Ok(mesh),
+    }
 }
 
 /// Evaluate the metric, clamped to SPD ([`clamp_spd`]).
