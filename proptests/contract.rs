@@ -4,6 +4,8 @@
 //! curved surfaces, every planar remesher on polygons in isotropic and anisotropic metrics.
 //! A row added to a registry is checked here without a new test.
 
+#[path = "seed.rs"]
+mod seed;
 use conemesh::contract::{self, StrategyCase};
 use conemesh::ids::{EdgeKey, FaceId};
 use conemesh::mesh::{generators, Topology, TriMesh};
@@ -18,15 +20,7 @@ use rand::{Rng, SeedableRng};
 use std::collections::HashSet;
 
 fn config(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        failure_persistence: Some(Box::new(
-            proptest::test_runner::FileFailurePersistence::Direct(
-                "proptests/regressions/contract.txt",
-            ),
-        )),
-        ..Default::default()
-    }
+    seed::config(cases, "contract", 0xc077ac7)
 }
 
 fn surface(kind: u8, seed: u64) -> TriMesh {

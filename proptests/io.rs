@@ -3,25 +3,18 @@
 //! ASCII STL after welding); binary STL equal to the `f32`-rounded, welded mesh. PLY also
 //! returns its face properties, colours and uv; OBJ its uv.
 
+#[path = "seed.rs"]
+mod seed;
 use conemesh::io::{read_mesh, write_mesh_with, MeshAttributes, WriteOptions};
 use conemesh::mesh::generators;
 use conemesh::{TriMesh, VertexId};
 use nalgebra::{Point2, Point3};
 use proptest::prelude::*;
-use proptest::test_runner::FileFailurePersistence;
 use rand::{Rng as _, SeedableRng};
 use std::collections::HashMap;
 
-const CASES: u32 = 32;
-
-fn config() -> ProptestConfig {
-    ProptestConfig {
-        cases: CASES,
-        failure_persistence: Some(Box::new(FileFailurePersistence::Direct(
-            "proptests/regressions/io.txt",
-        ))),
-        ..Default::default()
-    }
+fn config(cases: u32) -> ProptestConfig {
+    seed::config(cases, "io", 0x10f0)
 }
 
 /// A small generated surface, perturbed and scaled by `10^scale` (seeded).
@@ -75,7 +68,7 @@ fn stl_expected(m: &TriMesh, round: impl Fn(f64) -> f64) -> TriMesh {
 }
 
 proptest! {
-    #![proptest_config(config())]
+    #![proptest_config(config(32))]
 
     #[test]
     fn every_format_round_trips(kind in 0u8..5, seed in any::<u64>(), scale in -8i32..8,
@@ -172,7 +165,7 @@ fn write_valid_files() -> Vec<(conemesh::io::Format, Vec<u8>)> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 256, ..config() })]
+    #![proptest_config(config(256))]
 
     /// Readers never panic: random byte edits and truncations of valid files either read or
     /// give a typed error.
@@ -276,8 +269,10 @@ fn valid_sols() -> &'static [Vec<u8>; 2] {
 }
 
 /// Algorithm 1 on whatever a mutated file read as: a certified mesh or a typed error, never
-/// a panic. Two patches and no improver keep each case to milliseconds; `--repair` runs
-/// first when the mesh is not an oriented manifold, as a user would try next.
+/// a panic nor a run that does not end (`CONEMESH_FUZZ_DUMP=<path.obj>` writes each case's
+/// mesh there before its run, so one that hangs can be taken out). Two patches and no
+/// improver keep each case to milliseconds; `--repair` runs first when the mesh is not an
+/// oriented manifold, as a user would try next.
 fn remesh_never_panics(mesh: &TriMesh, metric: Option<&[nalgebra::Matrix3<f64>]>) {
     use conemesh::pipeline::{RemeshOptions, Remesher, Stages};
     let options = RemeshOptions {
@@ -288,6 +283,10 @@ fn remesh_never_panics(mesh: &TriMesh, metric: Option<&[nalgebra::Matrix3<f64>]>
         improvers: vec![],
         ..Default::default()
     });
+    // A case that does not end is found by writing each one out first.
+    if let Some(path) = std::env::var_os("CONEMESH_FUZZ_DUMP") {
+        let _ = conemesh::io::write_mesh(std::path::Path::new(&path), mesh);
+    }
     let run = |m: &TriMesh, metric: Option<&[nalgebra::Matrix3<f64>]>| match metric {
         Some(t) => remesher.run_with_metric(m, t).map(|_| ()),
         None => remesher.run(m).map(|_| ()),
@@ -301,7 +300,7 @@ fn remesh_never_panics(mesh: &TriMesh, metric: Option<&[nalgebra::Matrix3<f64>]>
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 96, ..config() })]
+    #![proptest_config(config(96))]
 
     /// Structural mutations (lines deleted, duplicated, swapped; counts, indices and
     /// coordinates replaced by hostile values) of every text format, then byte edits of

@@ -4,6 +4,8 @@
 //!
 //! Case counts are fixed (`CASES`) so the suite's time is stable.
 
+#[path = "seed.rs"]
+mod seed;
 use conemesh::check::{check_mesh, CheckOptions, CheckReport};
 use conemesh::invariants::{
     certify_boundary_preserved, certify_same_topology, faces_intersect, is_degenerate,
@@ -13,20 +15,13 @@ use conemesh::mesh::generators;
 use conemesh::{Topology, TriMesh, VertexId};
 use nalgebra::Point3;
 use proptest::prelude::*;
-use proptest::test_runner::FileFailurePersistence;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 
 const CASES: u32 = 48;
 
 fn config() -> ProptestConfig {
-    ProptestConfig {
-        cases: CASES,
-        failure_persistence: Some(Box::new(FileFailurePersistence::Direct(
-            "proptests/regressions/mesh.txt",
-        ))),
-        ..Default::default()
-    }
+    seed::config(CASES, "mesh", 0x3e54)
 }
 
 fn rng(seed: u64) -> conemesh::Rng {

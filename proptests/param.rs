@@ -2,6 +2,8 @@
 //! thin and very obtuse triangles, and strongly curved sphere caps. The certificate always
 //! holds, the energy never increases, and no iterate has a non-positive triangle.
 
+#[path = "seed.rs"]
+mod seed;
 use conemesh::invariants::certify_bijective;
 use conemesh::mesh::generators;
 use conemesh::param::{
@@ -59,13 +61,7 @@ fn case(kind: u8, a: f64, b: f64, seed: u64) -> TriMesh {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: 32,
-        failure_persistence: Some(Box::new(
-            proptest::test_runner::FileFailurePersistence::Direct("proptests/regressions/param.txt"),
-        )),
-        ..Default::default()
-    })]
+    #![proptest_config(seed::config(32, "param", 0x9a5a))]
 
     #[test]
     fn every_iterate_is_certified_and_energy_never_increases(

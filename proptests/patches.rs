@@ -1,5 +1,7 @@
 //! Property tests of patch generation (Sec. 3.2): the exact disk rule, certified covering runs.
 
+#[path = "seed.rs"]
+mod seed;
 use conemesh::ids::FaceId;
 use conemesh::invariants::certify_disk;
 use conemesh::mesh::{generators, Topology, TriMesh};
@@ -10,15 +12,7 @@ use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 
 fn config(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        failure_persistence: Some(Box::new(
-            proptest::test_runner::FileFailurePersistence::Direct(
-                "proptests/regressions/patches.txt",
-            ),
-        )),
-        ..Default::default()
-    }
+    seed::config(cases, "patches", 0x9a7c4)
 }
 
 fn surface(kind: u8, seed: u64) -> TriMesh {

@@ -4,23 +4,18 @@
 //!
 //! Case counts are fixed (`CASES`) so the suite's time is stable.
 
+#[path = "seed.rs"]
+mod seed;
 use conemesh::predicates::{
     incircle, orient2d, orient3d, segment_triangle_intersect, triangles_intersect, Sign,
 };
 use nalgebra::{Point2, Point3};
 use proptest::prelude::*;
-use proptest::test_runner::FileFailurePersistence;
 
 const CASES: u32 = 512;
 
 fn config() -> ProptestConfig {
-    ProptestConfig {
-        cases: CASES,
-        failure_persistence: Some(Box::new(FileFailurePersistence::Direct(
-            "proptests/regressions/predicates.txt",
-        ))),
-        ..Default::default()
-    }
+    seed::config(CASES, "predicates", 0x9ed1c)
 }
 
 fn p2() -> impl Strategy<Value = Point2<f64>> {

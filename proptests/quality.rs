@@ -2,6 +2,8 @@
 //! translated, metric conjugated R M Rᵀ) and uniform scaling (mesh ×s, metric ÷s²) change
 //! neither q, θ, L_avg/L_tar nor the relative approximation error.
 
+#[path = "seed.rs"]
+mod seed;
 use conemesh::mesh::generators;
 use conemesh::quality::{
     approximation_error, edge_conformity, edge_length_average, quality_stats, QualityStats,
@@ -12,15 +14,7 @@ use proptest::prelude::*;
 use rand::{Rng as _, SeedableRng};
 
 fn config(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        failure_persistence: Some(Box::new(
-            proptest::test_runner::FileFailurePersistence::Direct(
-                "proptests/regressions/quality.txt",
-            ),
-        )),
-        ..Default::default()
-    }
+    seed::config(cases, "quality", 0x9a11)
 }
 
 /// A perturbed torus and a random per-vertex metric: rank 2 (curvature-like, zero along a

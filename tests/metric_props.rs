@@ -1,6 +1,8 @@
 //! Property tests of the metric stage: projection onto the reference surface, interpolation,
 //! and independence of the unit-space curvature metric from the file's placement and scale.
 
+#[path = "../proptests/seed.rs"]
+mod seed;
 use conemesh::mesh::generators;
 use conemesh::metric::{curvature_metric, MetricField, MetricOptions, Normalization};
 use conemesh::{FaceId, SurfaceLocation, TriMesh};
@@ -9,15 +11,7 @@ use proptest::prelude::*;
 use std::sync::OnceLock;
 
 fn config(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        failure_persistence: Some(Box::new(
-            proptest::test_runner::FileFailurePersistence::Direct(
-                "proptests/regressions/metric.txt",
-            ),
-        )),
-        ..Default::default()
-    }
+    seed::config(cases, "metric", 0x3e7c)
 }
 
 fn field() -> &'static MetricField {
