@@ -173,9 +173,10 @@ const MAX_PIECES_PER_LONG_EDGE: usize = 1 << 14;
 
 /// The piece ends of `chain` (edge metric lengths `len`): when `round(S)` is at least the
 /// chain's edge count, every chain vertex and each edge cut into `round(length)` pieces (at
-/// most [`MAX_PIECES_PER_LONG_EDGE`]); otherwise `round(S)` pieces (at least 3 on a closed chain), more while a piece's chord is farther than `max_deviation` (0: no bound)
-/// from the chain vertices it replaces, so a curved crease keeps the distance tolerance
-/// the fidelity control asks of the faces.
+/// most [`MAX_PIECES_PER_LONG_EDGE`]); otherwise `round(S)` pieces (at least 3 on a closed
+/// chain), more while a piece's chord is farther than `max_deviation` (0: no bound) from the
+/// chain vertices it replaces, so a curved crease keeps the distance tolerance the fidelity
+/// control asks of the faces.
 fn chain_ends(
     reference: &TriMesh,
     chain: &[VertexId],

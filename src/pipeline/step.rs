@@ -536,7 +536,7 @@ fn remesh_and_lift(
                 .map_err(|e| {
                     // The faces made before the cap stopped it are work the budget counts.
                     if let crate::remesh2d::Remesh2dError::TooDense { faces, .. } = e {
-                        counters.work += faces as usize;
+                        counters.work = counters.work.saturating_add(faces as usize);
                     }
                     AttemptFailure::at(Stage::PlanarRemeshing)(e.into())
                 })?;

@@ -22,7 +22,8 @@ pub fn metric_length(metric: &dyn Metric2d, a: &Point2<f64>, b: &Point2<f64>, n:
 
 /// Subdivide every side of the closed polygon `corners` so that its pieces have metric length
 /// close to `target_length` (each side gets `max(1, round(len / target_length))` pieces at
-/// equal metric-length spacing, 64 samples per side; at most 2^20 pieces). Corners are kept bit for bit, in order.
+/// equal metric-length spacing, 64 samples per side; at most 2^20 pieces). Corners are kept
+/// bit for bit, in order.
 pub fn resample_polygon(
     corners: &[Point2<f64>],
     metric: &dyn Metric2d,
