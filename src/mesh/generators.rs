@@ -579,6 +579,56 @@ pub fn genus_plate(g: usize, res: usize) -> TriMesh {
     m.without_unreferenced_vertices().0
 }
 
+/// The bumpy sphere of the scaling benchmark: [`icosphere`] of radius 1 at `level`
+/// (`20·4^level` faces) with the radius modulated by `1 + 0.1·sin 5θ·sin 4φ` (θ polar, φ
+/// azimuth), so the curvature metric varies over the surface at every level.
+pub fn bumpy_sphere(level: u32) -> TriMesh {
+    let mut m = icosphere(1.0, level);
+    for p in &mut m.positions {
+        let r = p.coords.norm();
+        let theta = (p.z / r).clamp(-1.0, 1.0).acos();
+        let phi = p.y.atan2(p.x);
+        *p = Point3::from(p.coords * (1.0 + 0.1 * (5.0 * theta).sin() * (4.0 * phi).sin()));
+    }
+    m
+}
+
+/// A scan-like surface for the scaling benchmark: [`bumpy_sphere`] at `level` with every
+/// vertex moved along its radius by seeded uniform noise of ±15 % of the mean edge length
+/// (a scanner's noise), and the cap `z > 0.9` cut away (a scan's hole: an open boundary
+/// whose curve is jagged at the scale of the edges).
+pub fn noisy_scan(level: u32, seed: u64) -> TriMesh {
+    use rand::SeedableRng;
+    let m = bumpy_sphere(level);
+    let mean_edge = {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for t in &m.triangles {
+            for i in 0..3 {
+                sum += (m.positions[t[i].idx()] - m.positions[t[(i + 1) % 3].idx()]).norm();
+                n += 1;
+            }
+        }
+        sum / n.max(1) as f64
+    };
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let positions: Vec<Point3<f64>> = m
+        .positions
+        .iter()
+        .map(|p| {
+            let r = p.coords.norm();
+            let dr = rng.random_range(-0.15..0.15) * mean_edge;
+            Point3::from(p.coords * ((r + dr) / r))
+        })
+        .collect();
+    let tris: Vec<[usize; 3]> = m
+        .triangles
+        .iter()
+        .filter(|t| t.iter().all(|v| m.positions[v.idx()].z <= 0.9))
+        .map(|t| [t[0].idx(), t[1].idx(), t[2].idx()])
+        .collect();
+    build(positions, tris).without_unreferenced_vertices().0
+}
+
 /// Move every vertex by a uniformly random vector of length ≤ `amplitude` (seeded).
 pub fn perturb<R: Rng>(mesh: &TriMesh, amplitude: f64, rng: &mut R) -> TriMesh {
     let mut m = mesh.clone();

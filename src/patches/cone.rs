@@ -21,43 +21,50 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 /// The next seed vertex (see module docs), or `None` when every face is processed.
+///
+/// One pass over the faces marks, per vertex, whether it has an unprocessed unblocked face
+/// (free), a processed face (on the front when also free) and a blocked face; the candidates
+/// are then read in id order, so no list of the mesh's size is sorted for every patch.
 pub fn pick_seed_vertex(ctx: &PatchContext<'_>, rng: &mut ChaCha8Rng) -> Option<VertexId> {
+    const FREE: u8 = 1;
+    const BY_PROCESSED: u8 = 2;
+    const BY_BLOCKED: u8 = 4;
     let mesh = ctx.mesh;
     let processed = |f: FaceId| ctx.processed.get(f.idx()).copied().unwrap_or(false);
-    let mut free: Vec<VertexId> = Vec::new();
+    let mut mark = vec![0u8; mesh.n_vertices()];
     let mut any_processed = false;
     for f in mesh.faces() {
-        if processed(f) {
-            any_processed = true;
-        } else if !ctx.is_blocked(f) {
-            free.extend(mesh.face(f));
+        let (done, blocked) = (processed(f), ctx.is_blocked(f));
+        any_processed |= done;
+        let bit = match (done, blocked) {
+            (true, true) => BY_PROCESSED | BY_BLOCKED,
+            (true, false) => BY_PROCESSED,
+            (false, true) => BY_BLOCKED,
+            (false, false) => FREE,
+        };
+        for v in mesh.face(f) {
+            mark[v.idx()] |= bit;
         }
     }
     // A seed next to another patch of the batch could only start a patch inside its margin.
-    if ctx.blocked.is_some() {
-        free.retain(|&v| {
-            !ctx.topology
-                .vertex_faces(v)
-                .iter()
-                .any(|&f| ctx.is_blocked(f))
-        });
+    let free = |m: u8| m & FREE != 0 && (ctx.blocked.is_none() || m & BY_BLOCKED == 0);
+    let pick = |want: u8| -> Vec<VertexId> {
+        mark.iter()
+            .enumerate()
+            .filter(|&(_, &m)| free(m) && m & want == want)
+            .map(|(v, _)| VertexId::new(v))
+            .collect()
+    };
+    let mut candidates = match any_processed {
+        true => pick(BY_PROCESSED),
+        false => Vec::new(),
+    };
+    // Processed and unprocessed regions may not touch (another component): fall back.
+    if candidates.is_empty() {
+        candidates = pick(0);
     }
-    if free.is_empty() {
+    if candidates.is_empty() {
         return None;
-    }
-    free.sort_unstable();
-    free.dedup();
-    let mut candidates = free.clone();
-    if any_processed {
-        let front: Vec<VertexId> = free
-            .iter()
-            .copied()
-            .filter(|&v| ctx.topology.vertex_faces(v).iter().any(|&f| processed(f)))
-            .collect();
-        // Processed and unprocessed regions may not touch (another component): fall back.
-        if !front.is_empty() {
-            candidates = front;
-        }
     }
     Some(candidates[rng.random_range(0..candidates.len())])
 }

@@ -15,6 +15,7 @@
 //! MMG side by side ([`analytic`]).
 
 mod analytic;
+mod scaling;
 mod side_by_side;
 mod tools;
 
@@ -32,6 +33,9 @@ const MESH_EXTENSIONS: [&str; 5] = ["obj", "off", "ply", "stl", "mesh"];
 pub enum Suite {
     /// Surfaces with user-style metrics (`conemesh::suite::ANALYTIC`): conemesh and MMG.
     Analytic,
+    /// Generated surfaces of 20k to 1.3M faces (the bumpy sphere and a noisy open scan at
+    /// icosphere levels 5-8), run as a folder; adds the fitted time exponent and peak memory.
+    Scaling,
 }
 
 /// Arguments of `conemesh bench`.
@@ -61,7 +65,8 @@ pub struct BenchArgs {
     /// `conemesh eval` at L_tar = 1; the table is `analytic.md`.
     #[arg(long, value_enum)]
     pub suite: Option<Suite>,
-    /// Suite only: run the cases whose name contains SUBSTRING (repeatable; default all).
+    /// Suite only: run the cases whose name contains SUBSTRING (repeatable; default all;
+    /// the scaling cases are `bumpy-l5` … `bumpy-l8` and `scan-l5` … `scan-l8`).
     #[arg(long = "case", value_name = "SUBSTRING", requires = "suite")]
     pub cases: Vec<String>,
     /// MMG's surface remesher [default: `mmgs_O3` on PATH, else $CONEMESH_MMG; without one
@@ -79,12 +84,7 @@ pub struct BenchArgs {
     /// --threads N`; e.g. `--threads 1,2 -- --batch 8`); the first count's run is the one
     /// tabled and compared with MMG, and a table gives every count's time, the speed-up over
     /// the first and whether the output is byte for byte the first's.
-    #[arg(
-        long,
-        value_name = "N,N,...",
-        value_delimiter = ',',
-        conflicts_with = "suite"
-    )]
+    #[arg(long, value_name = "N,N,...", value_delimiter = ',')]
     pub threads: Vec<usize>,
 }
 
@@ -211,9 +211,15 @@ impl Numbers {
 /// Run `conemesh bench`.
 pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
     if let Some(Suite::Analytic) = args.suite {
+        ensure!(
+            args.threads.is_empty(),
+            "--threads is for a folder or `--suite scaling`, not the analytic suite"
+        );
         return analytic::run(&args);
     }
-    let meshes = if args.meshes.is_empty() {
+    let meshes = if args.suite == Some(Suite::Scaling) {
+        scaling::write_cases(&args.out_dir, &args.cases)?
+    } else if args.meshes.is_empty() {
         meshes_in(&args.dir)?
     } else {
         args.meshes.clone()
@@ -309,7 +315,22 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
         rows.push(MeshRows { row, threads, pair });
     }
     let header = header.end();
-    let table = table(&rows, &folder, &header);
+    let mut table = table(&rows, &folder, &header);
+    if args.suite == Some(Suite::Scaling) {
+        let points: Vec<scaling::Point> = rows
+            .iter()
+            .filter_map(|r| {
+                let n = r.row.outcome.as_ref().ok()?;
+                Some(scaling::Point {
+                    name: &r.row.name,
+                    faces_in: n.faces_in as f64,
+                    seconds: n.seconds,
+                    peak_mb: n.peak_mb,
+                })
+            })
+            .collect();
+        scaling::section(&mut table, &points);
+    }
     print!("{table}");
     let path = args.out_dir.join("remesh.md");
     conemesh::io::write_bytes_atomic(&path, table.as_bytes())
