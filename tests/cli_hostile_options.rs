@@ -257,3 +257,41 @@ fn a_plots_folder_under_a_file_or_a_missing_folder_is_refused_before_any_work() 
     }
     assert_eq!(temporaries(dir.path()), Vec::<String>::new());
 }
+
+/// An output path that is not UTF-8 (the OS accepts any bytes but `/` and NUL) is written, and
+/// the report holds it lossily; it used to panic after the work was done.
+#[cfg(unix)]
+#[test]
+fn output_paths_that_are_not_utf8_are_written_and_reported_lossily() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = write_torus(dir.path());
+    let out = dir
+        .path()
+        .join(std::ffi::OsStr::from_bytes(b"out-\xe9.obj"));
+    let report = dir
+        .path()
+        .join(std::ffi::OsStr::from_bytes(b"report-\xe9.json"));
+    let o = Command::new(env!("CARGO_BIN_EXE_conemesh"))
+        .args([
+            "remesh",
+            &input,
+            "-q",
+            "--max-patches",
+            "2",
+            "--no-improve",
+            "-o",
+        ])
+        .arg(&out)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(out.exists() && report.exists(), "{err}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&report).expect("report")).expect("json");
+    let written = json["output"].as_str().expect("a string");
+    assert!(written.ends_with("out-\u{fffd}.obj"), "{written}");
+}

@@ -282,7 +282,8 @@ def read(path):
     V : numpy.ndarray of float64, shape (n, 3)
         Vertex positions, bit for bit as in the file.
     F : numpy.ndarray of int64, shape (m, 3)
-        Triangles (polygons are fan-triangulated, with a warning).
+        Triangles (polygons are cut into triangles inside them, with a warning;
+        a polygon that is not simple or too far from planar is refused).
 
     Raises
     ------

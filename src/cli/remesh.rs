@@ -222,20 +222,27 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
     let read = conemesh::io::ReadOptions {
         drop_repeated_indices: args.repair,
     };
-    let (name, mesh, repeated) = match &args.mesh {
+    let (name, mesh, repeated, polygons) = match &args.mesh {
         Some(p) => {
             let loaded = conemesh::io::read_mesh_with(p, &read)
                 .with_context(|| format!("reading {}", p.display()))?;
+            for w in &loaded.warnings {
+                if !args.quiet {
+                    eprintln!("warning: {w}");
+                }
+            }
             (
                 p.display().to_string(),
                 loaded.mesh,
                 loaded.repeated_index_faces,
+                loaded.polygons_triangulated,
             )
         }
         None => (
             "built-in torus".to_string(),
             conemesh::mesh::generators::default_surface(),
             Vec::new(),
+            0,
         ),
     };
     let short_name = args
@@ -330,7 +337,9 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("writing {}", args.output.display()))?;
     let json = serde_json::json!({
         "input": name,
-        "output": args.output,
+        "polygons_triangulated": polygons,
+        // A path the OS accepts need not be UTF-8: the report holds it lossily.
+        "output": args.output.to_string_lossy(),
         "seconds": elapsed,
         "peak_rss_mib": peak_rss_mib(),
         "repair": repair,

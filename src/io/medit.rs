@@ -1,6 +1,6 @@
 //! Medit / INRIA `.mesh` (ASCII): `MeshVersionFormatted`, `Dimension`, then sections
 //! `KEYWORD count records…` until `End`. `Vertices` (x y z ref, or x y ref in 2D, read with
-//! z = 0) and `Triangles` (a b c ref, 1-based) are read, `Quadrilaterals` fan-triangulated;
+//! z = 0) and `Triangles` (a b c ref, 1-based) are read, `Quadrilaterals` cut into triangles;
 //! every other known section is skipped by its record size. Triangle references are kept as
 //! the face attribute `ref` when any is non-zero, and written from the first face attribute.
 
@@ -136,7 +136,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let (mesh, polygons, origin, repeated) = build_mesh(path, F, positions, &faces)?;
     if polygons > 0 {
         warnings.push(format!(
-            "{path}: {polygons} quadrilaterals fan-triangulated"
+            "{path}: {polygons} quadrilaterals cut into triangles"
         ));
     }
     let mut attributes = MeshAttributes::default();

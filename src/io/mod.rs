@@ -12,11 +12,13 @@ mod obj;
 mod off;
 mod outputs;
 mod ply;
+mod polygon;
 pub mod sol;
 mod stl;
 mod text;
 
 pub use outputs::{Outputs, TEMP_PREFIX};
+pub use polygon::PolygonProblem;
 
 use crate::mesh::{MeshError, TriMesh};
 use nalgebra::{Point2, Point3};
@@ -162,6 +164,20 @@ pub enum IoError {
         /// the repeated vertex (0-based)
         vertex: usize,
     },
+    /// A polygon face that cannot be cut into triangles inside it ([`PolygonProblem`]).
+    #[error("{path}{}: face {face} ({corners} corners) {problem}", loc(.line))]
+    BadPolygon {
+        /// the file
+        path: String,
+        /// 1-based line (0 for binary formats)
+        line: usize,
+        /// face number in the file (0-based)
+        face: usize,
+        /// its number of corners
+        corners: usize,
+        /// what is wrong with it
+        problem: PolygonProblem,
+    },
     /// A PLY property type that the PLY format does not define.
     #[error("{path}{}: PLY property `{property}` of element `{element}` has unknown type `{ty}`", loc(.line))]
     UnknownProperty {
@@ -226,6 +242,7 @@ impl IoError {
             IoError::BadIndex { .. } => "bad-index",
             IoError::NonFinite { .. } => "non-finite",
             IoError::RepeatedVertex { .. } => "repeated-vertex",
+            IoError::BadPolygon { .. } => "bad-polygon",
             IoError::UnknownProperty { .. } => "unknown-property",
             IoError::Unsupported { .. } => "unsupported",
             IoError::NoFaces { .. } => "no-faces",
@@ -240,14 +257,14 @@ impl IoError {
 pub struct LoadedMesh {
     /// The triangles and positions as read (unreferenced vertices kept).
     pub mesh: TriMesh,
-    /// Polygon faces with more than three corners that were fan-triangulated.
+    /// Polygon faces with more than three corners that were cut into triangles.
     pub polygons_triangulated: usize,
     /// Vertices merged because they had bit-identical positions (STL).
     pub welded_vertices: usize,
     /// Human-readable warnings (one line each).
     pub warnings: Vec<String>,
     /// Attributes found in the file (OBJ `vt`, PLY `u v`, PLY integer face properties and
-    /// `red green blue`), per triangle after fan triangulation.
+    /// `red green blue`), per triangle after polygons are cut into triangles.
     pub attributes: MeshAttributes,
     /// Faces that use a vertex twice (after STL's welding of corners), left out of `mesh`.
     /// Only [`ReadOptions::drop_repeated_indices`] lets a read return them; otherwise the
@@ -524,7 +541,8 @@ impl RawFaces {
     }
 }
 
-/// Check indices, fan-triangulate polygons and build the validated [`TriMesh`]. Returns the
+/// Check indices, cut polygons into triangles inside them ([`polygon`]) and build the
+/// validated [`TriMesh`]. Returns the
 /// mesh, the number of polygons triangulated, for each triangle the face it came from, and
 /// the faces left out because they use a vertex twice (the caller refuses them unless asked
 /// to drop them, [`read_mesh_bytes_with`]).
@@ -578,11 +596,17 @@ pub(crate) fn build_mesh(
         if poly.len() > 3 {
             polygons += 1;
         }
-        // Fan triangulation around the first corner keeps the polygon's orientation.
-        for k in 1..poly.len() - 1 {
-            tris.push([poly[0] as usize, poly[k] as usize, poly[k + 1] as usize]);
-            origin.push(f);
-        }
+        let corners: Vec<usize> = poly.iter().map(|&i| i as usize).collect();
+        let cut =
+            polygon::triangulate(&positions, &corners).map_err(|problem| IoError::BadPolygon {
+                path: path.to_string(),
+                line,
+                face: f,
+                corners: corners.len(),
+                problem,
+            })?;
+        origin.extend(cut.iter().map(|_| f));
+        tris.extend(cut);
     }
     // Nothing left to repair when every face repeats a vertex.
     if let (true, Some(r)) = (tris.is_empty(), repeated.first()) {

@@ -1,8 +1,9 @@
 //! Wavefront OBJ: `v x y z`, `vt u v`, `f a a/b a//c a/b/c` with 1-based or negative
 //! (relative) indices. Normals, groups, objects, smoothing groups, materials, lines and points
-//! are ignored; other keywords are ignored with a warning.
+//! are ignored; other keywords are ignored with a warning. Names (`g`, `o`, `usemtl`, …) and
+//! comments may hold bytes that are not UTF-8.
 
-use super::text::{as_text, float, int, short};
+use super::text::{as_text_with_names, float, int, short};
 use super::{build_mesh, uv_per_vertex, IoError, LoadedMesh, MeshAttributes, RawFaces};
 use crate::mesh::TriMesh;
 use nalgebra::{Point2, Point3};
@@ -48,6 +49,9 @@ const IGNORED: &[&str] = &[
     "stech",
 ];
 
+/// Keywords followed by a name, which may hold any bytes (`text::as_text_with_names`).
+const NAMES: &[&str] = &["g", "o", "s", "usemtl", "mtllib", "usemap", "maplib"];
+
 /// Resolve an OBJ index (1-based, or negative: relative to the `n` elements defined so far)
 /// to 0-based; `None` for 0 or an index before the first element.
 fn resolve(i: i64, n: usize) -> Option<i64> {
@@ -62,7 +66,7 @@ fn resolve(i: i64, n: usize) -> Option<i64> {
 }
 
 pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
-    let text = as_text(bytes, path, F)?;
+    let text = as_text_with_names(bytes, path, F, NAMES)?;
     let mut positions: Vec<Point3<f64>> = Vec::new();
     let mut vts: Vec<Point2<f64>> = Vec::new();
     let mut faces = RawFaces::with_capacity(0, 1);
@@ -70,7 +74,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let mut corner_vt: Option<Vec<(usize, i64)>> = Some(Vec::new());
     let mut unknown: Vec<String> = Vec::new();
     let mut any = false;
-    for (i, raw) in super::text::lines(text).enumerate() {
+    for (i, raw) in super::text::lines(&text).enumerate() {
         let l = i + 1;
         let s = raw.split('#').next().unwrap_or("");
         let mut t = s.split_ascii_whitespace();
@@ -177,7 +181,9 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let n_v = positions.len();
     let (mesh, polygons, _, repeated) = build_mesh(path, F, positions, &faces)?;
     if polygons > 0 {
-        warnings.push(format!("{path}: {polygons} polygon faces fan-triangulated"));
+        warnings.push(format!(
+            "{path}: {polygons} polygon faces cut into triangles"
+        ));
     }
     let mut attributes = MeshAttributes::default();
     if let Some(c) = corner_vt.filter(|c| !c.is_empty()) {

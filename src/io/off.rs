@@ -2,7 +2,7 @@
 //! Variants `COFF`, `NOFF`, `STOFF`, … carry extra per-vertex values, which are skipped
 //! (each vertex and face is one line). Binary OFF and 4D/nD OFF are refused by name.
 
-use super::text::{as_text, count, float, int};
+use super::text::{as_text_with_names, count, float, int};
 use super::{build_mesh, check_claim, IoError, LoadedMesh, RawFaces};
 use crate::mesh::TriMesh;
 use nalgebra::Point3;
@@ -11,7 +11,8 @@ use std::io::Write;
 const F: &str = "OFF";
 
 pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
-    let text = as_text(bytes, path, F)?;
+    let text = as_text_with_names(bytes, path, F, &[])?;
+    let text: &str = &text;
     let mut lines = super::text::lines(text)
         .enumerate()
         .map(|(i, l)| (i + 1, l.split('#').next().unwrap_or("").trim()))
@@ -163,7 +164,9 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     }
     let (mesh, polygons, _, repeated) = build_mesh(path, F, positions, &faces)?;
     if polygons > 0 {
-        warnings.push(format!("{path}: {polygons} polygon faces fan-triangulated"));
+        warnings.push(format!(
+            "{path}: {polygons} polygon faces cut into triangles"
+        ));
     }
     Ok(LoadedMesh {
         mesh,

@@ -228,6 +228,8 @@ impl Reader<'_, '_> {
 }
 
 struct Header {
+    /// Header lines skipped (unknown keywords), one warning each.
+    warnings: Vec<String>,
     elements: Vec<Element>,
     format: Option<(bool, bool)>, // (binary, big endian)
     body_start: usize,
@@ -278,16 +280,25 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
             .map_or(bytes.len(), |k| pos + k);
         line_no += 1;
         let raw = &bytes[pos..end];
-        let text =
-            std::str::from_utf8(raw).map_err(|_| err(line_no, "header line is not text".into()))?;
         let crlf = bytes.get(end) == Some(&b'\r') && bytes.get(end + 1) == Some(&b'\n');
         pos = (end + if crlf { 2 } else { 1 }).min(bytes.len());
+        let Ok(text) = std::str::from_utf8(raw) else {
+            // Comments may hold any bytes (an exporter's code page); nothing else may.
+            let word = raw
+                .split(|b| b.is_ascii_whitespace())
+                .find(|w| !w.is_empty());
+            if matches!(word, Some(b"comment" | b"obj_info")) {
+                continue;
+            }
+            return Err(err(line_no, "header line is not text".into()));
+        };
         if text.trim() == "end_header" {
             break pos;
         }
         lines.push((line_no, text));
     };
     let mut h = Header {
+        warnings: Vec::new(),
         elements: Vec::new(),
         format: None,
         body_start,
@@ -366,7 +377,13 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
                 };
                 el.props.push(prop);
             }
-            Some(k) => return Err(err(l, format!("unknown header keyword `{}`", short(k)))),
+            // A line that is no keyword (an exporter's free text, `Created by Blender3D 247
+            // ...`) cannot change the data layout, which only `format`, `element` and
+            // `property` lines set: it is skipped, with a warning naming it.
+            Some(k) => h.warnings.push(format!(
+                "{path}:{l}: PLY header line starting with unknown keyword `{}` skipped",
+                short(k)
+            )),
         }
     }
     if h.format.is_none() {
@@ -383,7 +400,7 @@ struct FaceRoles {
 }
 
 pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
-    let h = parse_header(bytes, path)?;
+    let mut h = parse_header(bytes, path)?;
     let (binary, big_endian) = h.format.unwrap_or((false, false));
     let body_bytes = &bytes[h.body_start..];
     let body = if binary {
@@ -436,7 +453,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let mut colors: Option<Vec<[u8; 3]>> = None;
     let mut saw_vertex = false;
     let mut saw_faces = false;
-    let mut warnings = Vec::new();
+    let mut warnings = std::mem::take(&mut h.warnings);
     let mut vals: Vec<Num> = Vec::new();
     let mut list: Vec<i64> = Vec::new();
     for el in &h.elements {
@@ -583,7 +600,9 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let n_v = positions.len();
     let (mesh, polygons, origin, repeated) = build_mesh(path, F, positions, &faces)?;
     if polygons > 0 {
-        warnings.push(format!("{path}: {polygons} polygon faces fan-triangulated"));
+        warnings.push(format!(
+            "{path}: {polygons} polygon faces cut into triangles"
+        ));
     }
     // Face attributes follow their face into each of its triangles (tristrips carry none).
     let spread =

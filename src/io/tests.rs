@@ -526,3 +526,98 @@ fn utf8_byte_order_mark_is_skipped() -> Result<(), IoError> {
     assert!(m.warnings.is_empty(), "{:?}", m.warnings);
     Ok(())
 }
+
+#[test]
+fn names_and_comments_may_hold_latin1_bytes_but_numbers_may_not() -> Result<(), IoError> {
+    let obj = b"# caf\xe9\nmtllib caf\xe9.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+                g gr\xfcn\nusemtl mat\xe9riau\no \x84obj\nf 1 2 3 4 # \xff\n";
+    let m = read_mesh_bytes(obj, Format::Obj, "latin1.obj")?;
+    assert_eq!((m.mesh.n_vertices(), m.mesh.n_faces()), (4, 2));
+    let off = b"OFF\n# \xe9t\xe9\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    assert_eq!(
+        read_mesh_bytes(off, Format::Off, "c.off")?.mesh.n_faces(),
+        1
+    );
+    // The same byte inside a number, or after a keyword that is no name, is binary data.
+    for bad in [
+        &b"v 0 0 0\nv 1 \xe90 0\nv 0 1 0\nf 1 2 3\n"[..],
+        b"v 0 0 0\nvt \xe9\n",
+    ] {
+        let e = read_mesh_bytes(bad, Format::Obj, "bad.obj").expect_err("refused");
+        assert!(matches!(e, IoError::Parse { line: 2, .. }), "{e}");
+        assert!(e.to_string().contains("not text"), "{e}");
+    }
+    // A NUL byte still marks a binary file, even in a comment.
+    let e = read_mesh_bytes(b"# a\0b\nv 0 0 0\n", Format::Obj, "nul.obj").expect_err("refused");
+    assert!(e.to_string().contains("binary data"), "{e}");
+    Ok(())
+}
+
+#[test]
+fn a_ply_header_line_that_is_no_keyword_is_skipped_with_a_warning() -> Result<(), IoError> {
+    let head = "ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org\n";
+    let rest = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+                0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    let mut bytes = head.as_bytes().to_vec();
+    bytes.extend_from_slice(b"comment caf\xe9\nobj_info \xff\n");
+    bytes.extend_from_slice(rest.as_bytes());
+    let m = read_mesh_bytes(&bytes, Format::Ply, "blender.ply")?;
+    assert_eq!(m.mesh.n_faces(), 1);
+    assert!(
+        m.warnings
+            .iter()
+            .any(|w| w.contains("blender.ply:3") && w.contains("`Created`")),
+        "{:?}",
+        m.warnings
+    );
+    // What sets the layout is still read strictly: a property of an unknown type, or a
+    // header line that is not text and no comment.
+    let unknown = format!(
+        "{head}{}",
+        rest.replace("property float z", "property float128 z")
+    );
+    assert!(rd(&unknown, Format::Ply).is_err());
+    let mut not_text = head.as_bytes().to_vec();
+    not_text.extend_from_slice(b"element \xe9 3\n");
+    not_text.extend_from_slice(rest.as_bytes());
+    assert!(read_mesh_bytes(&not_text, Format::Ply, "x.ply").is_err());
+    Ok(())
+}
+
+#[test]
+fn a_concave_polygon_reads_into_triangles_inside_it_and_a_crossing_one_is_refused() {
+    // An L: a fan from its first corner (the reflex one) would put a triangle outside it.
+    let l = "v 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4 5 6\n";
+    let m = rd(l, Format::Obj).expect("simple");
+    assert_eq!(m.mesh.n_faces(), 4);
+    let area: f64 = m
+        .mesh
+        .faces()
+        .map(|f| m.mesh.face_normal(f).z * m.mesh.face_area(f))
+        .sum();
+    assert!((area - 3.0).abs() < 1e-12, "{area}");
+    for f in m.mesh.faces() {
+        assert!(m.mesh.face_normal(f).z > 0.0);
+        let c = m.mesh.face_centroid(f);
+        assert!(
+            !(c.x > 1.0 && c.y > 1.0),
+            "triangle {f} lies in the L's notch"
+        );
+    }
+    let bow_tie = "v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n";
+    let e = rd(bow_tie, Format::Obj).expect_err("not simple");
+    assert!(
+        matches!(
+            e,
+            IoError::BadPolygon {
+                line: 5,
+                face: 0,
+                corners: 4,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert_eq!(e.kind(), "bad-polygon");
+}

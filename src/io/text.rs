@@ -26,6 +26,57 @@ pub(crate) fn as_text<'a>(
     })
 }
 
+/// The file as text where names and comments may hold any bytes: like [`as_text`], except
+/// that a line whose first word is one of `name_keywords` (OBJ's `g`, `usemtl`, …), or whose
+/// first byte that is not UTF-8 follows a `#`, has such bytes replaced by U+FFFD. Names and
+/// comments carry nothing a mesh needs, and exporters write them in the user's code page (a
+/// Latin-1 material name). Anywhere else, and a NUL byte anywhere, the file is binary data,
+/// as with [`as_text`]; numbers are read from the same bytes either way.
+pub(crate) fn as_text_with_names<'a>(
+    bytes: &'a [u8],
+    path: &str,
+    format: &'static str,
+    name_keywords: &[&str],
+) -> Result<std::borrow::Cow<'a, str>, IoError> {
+    let strict = as_text(bytes, path, format);
+    if strict.is_ok() || bytes.contains(&0) {
+        return strict.map(std::borrow::Cow::Borrowed);
+    }
+    let all = bytes.len();
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let mut text = String::with_capacity(bytes.len());
+    let mut start = all - bytes.len();
+    for (line_index, line) in bytes.split_inclusive(|&b| b == b'\n').enumerate() {
+        match std::str::from_utf8(line) {
+            Ok(s) => text.push_str(s),
+            Err(e) => {
+                let bad = e.valid_up_to();
+                let word = line
+                    .split(|b| b.is_ascii_whitespace())
+                    .find(|w| !w.is_empty())
+                    .unwrap_or(&[]);
+                let named = name_keywords.iter().any(|k| k.as_bytes() == word);
+                let commented = line[..bad].contains(&b'#');
+                if !(named || commented) {
+                    return Err(IoError::Parse {
+                        path: path.to_string(),
+                        format,
+                        line: line_index + 1,
+                        message: format!(
+                            "binary data (byte {} is not text; only names and comments may \
+                             hold bytes that are not UTF-8)",
+                            start + bad
+                        ),
+                    });
+                }
+                text.push_str(&String::from_utf8_lossy(line));
+            }
+        }
+        start += line.len();
+    }
+    Ok(std::borrow::Cow::Owned(text))
+}
+
 /// The lines of `text`, ended by `\n`, `\r\n` or a lone `\r` (classic Mac OS files:
 /// `str::lines` would read such a file as one line), without their line ends.
 pub(crate) fn lines(text: &str) -> impl Iterator<Item = &str> {

@@ -29,6 +29,7 @@ pub struct RemeshOptions {
     /// Run the exact self-intersection test on the final mesh. Default `true`.
     pub check_self_intersections: bool,
     /// Where offending patches are written when a certificate fails. Default `None`.
+    #[serde(serialize_with = "lossy_path")]
     pub debug_dir: Option<PathBuf>,
     /// Stop after this many patches: the run then ends `Ok` with the unreached faces kept as
     /// they were, [`super::RemeshReport::budget_exhausted`] set and a
@@ -410,4 +411,9 @@ mod tests {
         );
         assert_eq!(seen, 1);
     }
+}
+
+/// A path in a report: a path the OS accepts need not be UTF-8, and is written lossily.
+fn lossy_path<S: serde::Serializer>(path: &Option<PathBuf>, s: S) -> Result<S::Ok, S::Error> {
+    serde::Serialize::serialize(&path.as_ref().map(|p| p.to_string_lossy()), s)
 }

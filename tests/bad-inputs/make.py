@@ -42,6 +42,8 @@ w("obj-no-faces.obj", "# only vertices\nv 0 0 0\nv 1 0 0\nv 0 1 0\n")
 w("obj-binary-garbage.obj", bytes(rng.randrange(256) for _ in range(300)))
 w("obj-two-coordinates.obj", "v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
 w("obj-repeated-vertex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -3\n")
+w("obj-bow-tie-polygon.obj", "v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n")
+w("obj-pinched-polygon.obj", "v 0 0 0\nv 2 0 0\nv 1 1 0\nv 2 2 0\nv 0 2 0\nv 1 1 0\nf 1 2 3 4 5 6\n")
 
 # ---- PLY
 HDR = "ply\nformat {}\nelement vertex {}\nproperty {t} x\nproperty {t} y\nproperty {t} z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n"
