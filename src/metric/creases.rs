@@ -24,7 +24,9 @@
 //! Without feature edges [`super::curvature_metric`] does not come here: the fit is the one
 //! of [`super::curvature`], bit for bit.
 
-use super::curvature::{fit_vertex, CurvatureOptions, PrincipalCurvature, MIN_NEIGHBOURS};
+use super::curvature::{
+    fit_vertex, CurvatureOptions, PrincipalCurvature, MAX_NEIGHBOURS, MIN_NEIGHBOURS,
+};
 use super::metric_from_curvature;
 use crate::ids::{EdgeKey, FaceId, VertexId};
 use crate::mesh::{Topology, TriMesh};
@@ -127,8 +129,8 @@ impl Scratch {
 
     /// The vertices within `radius` rings of `v` seen from sector `s` of `v`, rings grown only
     /// into the sectors of each reached vertex that contain a face already reached (so never
-    /// across a feature edge); grown further until [`MIN_NEIGHBOURS`] as in
-    /// [`super::curvature`]. Excludes `v`.
+    /// across a feature edge); grown further until [`MIN_NEIGHBOURS`] and cut at
+    /// [`MAX_NEIGHBOURS`] as in [`super::curvature`]. Excludes `v`.
     fn ring(
         &mut self,
         mesh: &TriMesh,
@@ -166,12 +168,21 @@ impl Scratch {
         }
         let mut depth = 1usize;
         loop {
+            let room = MAX_NEIGHBOURS.saturating_sub(self.ring.len());
+            frontier.truncate(room);
             self.ring.extend_from_slice(&frontier);
-            if (depth >= radius && self.ring.len() >= MIN_NEIGHBOURS) || frontier.is_empty() {
+            if (depth >= radius && self.ring.len() >= MIN_NEIGHBOURS)
+                || frontier.is_empty()
+                || self.ring.len() >= MAX_NEIGHBOURS
+            {
                 break;
             }
             let current = std::mem::take(&mut frontier);
             for &w in &current {
+                // Past the cap nothing more is kept: stop enumerating (a hub's faces).
+                if frontier.len() >= MAX_NEIGHBOURS {
+                    break;
+                }
                 let w = w as usize;
                 let faces = topo.vertex_faces(VertexId::new(w));
                 // The sectors of w that contain a reached face.

@@ -4,7 +4,8 @@
 //!
 //! For every vertex `v`:
 //! 1. the neighbourhood is the set of vertices within `radius` edge rings of `v` (grown further
-//!    if it has fewer than 5 other vertices, libigl's minimum of 6 points);
+//!    if it has fewer than 5 other vertices, libigl's minimum of 6 points; cut at
+//!    `MAX_NEIGHBOURS` in breadth-first order);
 //! 2. the frame normal `n₀` is the vertex's area-weighted normal, with a tangent pair
 //!    `(t₁, t₂)`; neighbours whose normal faces away from `n₀` (more than 90°, e.g. across a
 //!    sharp feature line) are dropped when at least 5 remain (libigl's defaults: `localMode`,
@@ -71,6 +72,12 @@ const FACING_MIN_COS: f64 = 1e-9;
 /// Minimum number of neighbours (besides the vertex) for a fit; libigl asks for 6 points
 /// including the vertex itself.
 pub(super) const MIN_NEIGHBOURS: usize = 5;
+
+/// Largest neighbourhood a fit uses: the rings stop growing, in breadth-first order, once they
+/// hold this many vertices, so a vertex next to a hub (a polygon cut into a fan, a CAD disk
+/// face: one vertex of 100,000 faces) costs a bounded fit instead of one over the whole mesh.
+/// The 5-rings of the shared meshes hold at most 211 vertices, so their fits are unchanged.
+pub(super) const MAX_NEIGHBOURS: usize = 512;
 
 /// A deterministic orthonormal tangent pair `(t1, t2)` with `t1 × t2 = n` for a unit normal
 /// `n`: `t1` is the coordinate axis least aligned with `n` (lowest index on ties), projected.
@@ -181,12 +188,16 @@ impl Scratch {
             if depth >= radius && self.ring.len() >= MIN_NEIGHBOURS {
                 break;
             }
+            let room = MAX_NEIGHBOURS - self.ring.len();
             let mut next = Vec::new();
-            for &w in &current {
+            'ring: for &w in &current {
                 for &u in adj.of(w as usize) {
                     if self.stamp[u as usize] != g {
                         self.stamp[u as usize] = g;
                         next.push(u);
+                        if next.len() == room {
+                            break 'ring;
+                        }
                     }
                 }
             }
@@ -194,6 +205,9 @@ impl Scratch {
                 break;
             }
             self.ring.extend_from_slice(&next);
+            if self.ring.len() == MAX_NEIGHBOURS {
+                break;
+            }
             current = next;
             depth += 1;
         }
@@ -450,6 +464,24 @@ mod tests {
         assert!(a.k1.abs() > 1.0, "{a:?}");
         assert!((a.k1 - b.k1).abs() < 1e-9 * a.k1.abs(), "{a:?} {b:?}");
         assert!((a.k2 - b.k2).abs() < 1e-9 * a.k1.abs(), "{a:?} {b:?}");
+        Ok(())
+    }
+
+    #[test]
+    fn a_hub_vertex_bounds_every_neighbourhood_and_a_flat_fan_stays_flat() -> Result<(), MetricError>
+    {
+        // A disk cut as one fan of 20,000 slices: every vertex's 2-ring holds the whole
+        // circle. The rings stop at MAX_NEIGHBOURS (the fit was quadratic in the mesh).
+        let fan = crate::mesh::generators::disk(1.0, 1, 20_000);
+        let adj = Adjacency::build(&fan);
+        let mut scratch = Scratch::new(fan.n_vertices());
+        let hubs_neighbour = (0..fan.n_vertices())
+            .find(|&v| adj.of(v).len() == 3)
+            .expect("a circle vertex");
+        scratch.k_ring(&adj, hubs_neighbour, 5);
+        assert_eq!(scratch.ring.len(), MAX_NEIGHBOURS);
+        let pcs = principal_curvatures(&fan, &CurvatureOptions::default())?;
+        assert!(pcs.iter().all(|p| p.k1.abs() < 1e-9 && p.k2.abs() < 1e-9));
         Ok(())
     }
 }
