@@ -378,6 +378,11 @@ impl Stages {
     }
 }
 
+/// A path in a report: a path the OS accepts need not be UTF-8, and is written lossily.
+fn lossy_path<S: serde::Serializer>(path: &Option<PathBuf>, s: S) -> Result<S::Ok, S::Error> {
+    serde::Serialize::serialize(&path.as_ref().map(|p| p.to_string_lossy()), s)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -411,9 +416,4 @@ mod tests {
         );
         assert_eq!(seen, 1);
     }
-}
-
-/// A path in a report: a path the OS accepts need not be UTF-8, and is written lossily.
-fn lossy_path<S: serde::Serializer>(path: &Option<PathBuf>, s: S) -> Result<S::Ok, S::Error> {
-    serde::Serialize::serialize(&path.as_ref().map(|p| p.to_string_lossy()), s)
 }
