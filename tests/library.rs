@@ -349,3 +349,24 @@ fn the_cli_reaches_every_registry() {
         );
     }
 }
+
+/// The report's `wall` gives each phase's wall-clock time: every phase took some time, and
+/// together they fit inside the time the caller measured around the run.
+#[test]
+fn the_report_gives_each_phase_its_wall_clock_time() {
+    let input = file_torus();
+    let clock = std::time::Instant::now();
+    let out = Remesher::new(RemeshOptions::default())
+        .run(&input)
+        .expect("remeshes");
+    let outside = clock.elapsed().as_secs_f64();
+    let w = out.unit.report.wall;
+    let phases = [w.setup, w.patch_loop, w.improve, w.finish];
+    assert!(phases.iter().all(|&t| t > 0.0), "{w:?}");
+    assert!(phases.iter().sum::<f64>() <= outside, "{w:?} against {outside} s");
+    // The patch loop's wall time is no more than its stages' times summed over patches (one
+    // thread per patch here: batch 1).
+    let t = &out.unit.report.times;
+    let stages = t.patches + t.param + t.transfer + t.remesh2d + t.lift + t.fidelity + t.stitch;
+    assert!(stages <= w.patch_loop + w.improve + w.finish, "{t:?} {w:?}");
+}

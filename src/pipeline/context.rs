@@ -186,6 +186,8 @@ pub struct LoopState {
     pub work_stopped: bool,
     /// Times and certificate counts.
     pub counters: Counters,
+    /// Wall-clock time of the run's phases so far.
+    pub wall: super::records::PhaseTimes,
     /// Per-patch records.
     pub records: Vec<PatchRecord>,
     /// What the retry ladder did.
@@ -285,6 +287,7 @@ impl LoopState {
             over_work_budget_at: None,
             work_stopped: false,
             counters: Counters::default(),
+            wall: Default::default(),
             records: Vec::new(),
             fallbacks: Fallbacks::default(),
             improvement: None,

@@ -256,6 +256,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
         work: state.counters.work,
         budget_exhausted: state.budget_exhausted,
         times: state.counters.times,
+        wall: state.wall,
         certificate: state.counters.cert,
         fallbacks: state.fallbacks,
         patch_records: state.records,

@@ -48,7 +48,7 @@ pub use options::{
 };
 pub use records::{
     AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,
-    PatchRecord, Progress, RemeshReport, RemeshResult, StageTimes, Warning,
+    PatchRecord, PhaseTimes, Progress, RemeshReport, RemeshResult, StageTimes, Warning,
 };
 pub use remesher::{Remeshed, Remesher};
 pub use sizing::{
@@ -77,12 +77,15 @@ pub fn remesh(
         i.validate()
             .map_err(|e| PipelineError::Input(format!("improver `{}`: {e}", i.name())))?;
     }
+    let clock = Instant::now();
     let topo = certified_input_topology(field)?;
     let plan = Plan::resolve(field, &topo, options)?;
     let ctx = RunContext::new(plan.quality_field(field), topo, &plan, stages);
     let mut state = LoopState::new(&ctx)?;
     state.index_faces(&ctx);
     let mut rng = crate::Rng::seed_from_u64(plan.options.seed);
+    state.wall.setup = clock.elapsed().as_secs_f64();
+    let clock = Instant::now();
     while state.face_remains(&ctx) {
         let batch = next_batch(&ctx, &mut state, &mut rng)?; // (a) Sec. 3.2, a vertex apart
         let outcomes = step::batch_steps(&ctx, &state, &batch, &mut rng)?; // (b)-(e), at the same time
@@ -94,9 +97,14 @@ pub fn remesh(
         options.cancel.check(state.patches)?;
     }
     state.loop_patches = state.patches;
+    state.wall.patch_loop = clock.elapsed().as_secs_f64();
     options.cancel.check(state.patches)?;
+    let clock = Instant::now();
     improvement::run(&ctx, &mut state, &mut rng)?; // Sec. 3.4, the improvers in order
+    state.wall.improve = clock.elapsed().as_secs_f64();
+    let clock = Instant::now();
     finish::certify_output(&ctx, &mut state)?;
+    state.wall.finish = clock.elapsed().as_secs_f64();
     Ok(finish::into_result(&ctx, state))
 }
 

@@ -11,6 +11,21 @@ use serde::ser::SerializeStruct;
 use serde::Serialize;
 use std::fmt;
 
+/// Wall-clock seconds of a run's phases, as a clock on the wall sees them, whatever the
+/// thread count ([`StageTimes`] sums the stages of a batch's patches, which may run at the
+/// same time).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct PhaseTimes {
+    /// The input's certificates, the plan, the context and the working mesh before the loop.
+    pub setup: f64,
+    /// Algorithm 1's loop over patches.
+    pub patch_loop: f64,
+    /// The improvers after the loop (Sec. 3.4).
+    pub improve: f64,
+    /// The output's certificates and the report.
+    pub finish: f64,
+}
+
 /// Time per stage, seconds: the patches of a batch run at the same time, and their stage
 /// times are summed, so with several threads the loop's stages add up to more than its wall
 /// time.
@@ -485,8 +500,10 @@ pub struct RemeshReport {
     /// The patch budget ([`RemeshOptions::max_patches`]) ran out before every face was
     /// processed.
     pub budget_exhausted: bool,
-    /// Per-stage times.
+    /// Per-stage times (summed over a batch's patches).
     pub times: StageTimes,
+    /// Wall-clock time of each phase of the run.
+    pub wall: PhaseTimes,
     /// Certificates.
     pub certificate: Certificate,
     /// What the retry ladder did.
