@@ -363,7 +363,10 @@ fn the_report_gives_each_phase_its_wall_clock_time() {
     let w = out.unit.report.wall;
     let phases = [w.setup, w.patch_loop, w.improve, w.finish];
     assert!(phases.iter().all(|&t| t > 0.0), "{w:?}");
-    assert!(phases.iter().sum::<f64>() <= outside, "{w:?} against {outside} s");
+    assert!(
+        phases.iter().sum::<f64>() <= outside,
+        "{w:?} against {outside} s"
+    );
     // The patch loop's wall time is no more than its stages' times summed over patches (one
     // thread per patch here: batch 1).
     let t = &out.unit.report.times;
