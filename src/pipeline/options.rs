@@ -130,17 +130,16 @@ impl Cancel {
     }
 }
 
-/// The default of [`RemeshOptions::batch`]: one patch at a time, until batches are shown to
-/// keep the quality rows (measured on the shared meshes at seed 1, batch 8 kept q_avg but
-/// missed the 1 % Hausdorff target on cow, decimated-knight and fertility; BENCHMARKS.md).
+/// The default of [`RemeshOptions::batch`]: one patch at a time (the paper's loop), until
+/// batches are shown to keep the quality rows (BENCHMARKS.md, "parallel patches").
 pub const DEFAULT_BATCH: usize = 1;
 
 /// The face budget of a run, as a multiple of the larger of the input's face count and the
 /// output expected with the a-priori fidelity scaling ([`super::Plan::expected_fidelity`]).
 /// Past it the fidelity control stops refining and no further sweep starts
-/// ([`Warning::FaceBudget`](super::Warning::FaceBudget)). The shared meshes stay below
-/// 1× except decimated-knight under the coarse-input profile (9×); a CAD part whose creases
-/// no feature line follows reached 13× after 20 of its patches and ran past 5 minutes.
+/// ([`Warning::FaceBudget`](super::Warning::FaceBudget)): above what any legitimate run
+/// needs, so that a run whose refinement runs away ends with a warning instead of running
+/// for hours (the measurements: paper-notes "Coarse inputs", notes/real-world-inputs.md).
 pub const FACE_BUDGET: f64 = 12.0;
 
 /// The work budget of a run ([`RemeshOptions::work_budget`]): faces handled by patch attempts,

@@ -2,8 +2,8 @@
 //! half-edge again.
 //!
 //! [`Topology::build`] sorts all half-edges; Algorithm 1 needs the topology after every
-//! patch, so on a mesh of 50k faces and thousands of patches the rebuilds were most of the run
-//! (issue 19's and 20's profiles). Here only the edges of the removed and the new faces are
+//! patch, and on a mesh of 50k faces and thousands of patches the rebuilds would be most of
+//! the run (notes/real-world-inputs.md). Here only the edges of the removed and the new faces are
 //! looked at again; the rest is carried over through the face renumbering, in linear passes
 //! without sorting. The result equals [`Topology::build`] on the new mesh, field for field,
 //! and debug builds check that after every update. When the replacement might change the

@@ -72,13 +72,14 @@ pub struct LctOptions {
     pub certify_every_round: bool,
     /// Start from the constrained Delaunay triangulation of the boundary polygon and of the
     /// domain's interior vertices that are `start_spacing · L` apart in the metric, instead of
-    /// the domain's triangulation (default true), so the result does not inherit the input's
-    /// connectivity.
+    /// the domain's triangulation, so the result does not inherit the input's connectivity
+    /// (default false; true in [`LctOptions::for_absolute_sizes`]).
     pub rebuild: bool,
     /// The spacing of the interior vertices kept for the start, times L (default 0.8).
     pub start_spacing: f64,
     /// After split and collapse, bring the vertex count to that of an ideal mesh of the
-    /// domain's metric area (default true), so edges have length L on average.
+    /// domain's metric area, so edges have length L on average (default false; true in
+    /// [`LctOptions::for_absolute_sizes`]).
     pub density: bool,
     /// The most faces a remesh may have (default [`MAX_LCT_FACES`]): a domain whose ideal
     /// mesh ([`super::ideal_faces`]) has more is refused up front, and so is a result with
@@ -96,9 +97,9 @@ pub const MAX_LCT_FACES: f64 = 4e6;
 /// [`Remesh2dError::TooDense`].
 pub const SPLIT_OVERSHOOT: f64 = 256.0;
 
-/// How far the split passes may take a mesh past [`LctOptions::max_faces`] (measured: 1.8×
-/// at the end of a round under the analytic suite's 1000:1 metric, where the pipeline's cap is
-/// 110k faces; a patch of a needle-shaped input went on to 11× and took 50 s).
+/// How far the split passes may take a mesh past [`LctOptions::max_faces`]: a legitimate
+/// remesh under a strongly anisotropic metric overshoots the cap within a round before its
+/// collapses bring it back, a runaway one does not stop (the measurements: notes/fuzz-hangs.md).
 pub const MAX_OVERSHOOT: f64 = 4.0;
 
 /// The floor of the split passes' base: a domain of a few faces with a tiny ideal count may
