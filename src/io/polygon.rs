@@ -234,6 +234,16 @@ fn crossed(
 mod tests {
     use super::*;
 
+    /// An L of area 3, counter-clockwise.
+    const L_SHAPE: [[f64; 2]; 6] = [
+        [0.0, 0.0],
+        [2.0, 0.0],
+        [2.0, 1.0],
+        [1.0, 1.0],
+        [1.0, 2.0],
+        [0.0, 2.0],
+    ];
+
     /// The polygon `pts` (in the plane z = 0) with corners 0..n.
     fn flat(pts: &[[f64; 2]]) -> (Vec<Point3<f64>>, Vec<usize>) {
         (
@@ -303,14 +313,6 @@ mod tests {
 
     #[test]
     fn l_comb_and_a_34_corner_concave_polygon_are_covered_from_inside() {
-        let l = [
-            [0.0, 0.0],
-            [2.0, 0.0],
-            [2.0, 1.0],
-            [1.0, 1.0],
-            [1.0, 2.0],
-            [0.0, 2.0],
-        ];
         // A comb: teeth up from a bar, the first corner in a notch (a fan from it goes outside).
         let mut comb = vec![[0.0, 0.0], [9.0, 0.0]];
         for k in (0..5).rev() {
@@ -332,7 +334,7 @@ mod tests {
             .skip(1)
             .take(34)
             .collect();
-        for pts in [&l[..], &comb, &star] {
+        for pts in [&L_SHAPE[..], &comb, &star] {
             let (p, ring) = flat(pts);
             let tris = triangulate(&p, &ring).expect("simple polygon");
             assert_covers(&p, &ring, &tris);
@@ -341,14 +343,7 @@ mod tests {
 
     #[test]
     fn a_clockwise_polygon_keeps_its_orientation() {
-        let (p, mut ring) = flat(&[
-            [0.0, 0.0],
-            [2.0, 0.0],
-            [2.0, 1.0],
-            [1.0, 1.0],
-            [1.0, 2.0],
-            [0.0, 2.0],
-        ]);
+        let (p, mut ring) = flat(&L_SHAPE);
         ring.reverse();
         let tris = triangulate(&p, &ring).expect("simple");
         assert_eq!(tris.len(), 4);

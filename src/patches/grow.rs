@@ -254,32 +254,6 @@ impl Ord for Entry {
     }
 }
 
-/// A face whose distance `D` was lowered, for the label-setting update: min-heap by `d`, then
-/// face id.
-#[derive(Copy, Clone, Debug)]
-struct Lowered {
-    d: f64,
-    face: FaceId,
-}
-
-impl PartialEq for Lowered {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for Lowered {}
-impl PartialOrd for Lowered {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Lowered {
-    fn cmp(&self, o: &Self) -> Ordering {
-        // Reversed: BinaryHeap is a max-heap.
-        o.d.total_cmp(&self.d).then(o.face.cmp(&self.face))
-    }
-}
-
 /// The result of [`grow_patch`].
 #[derive(Clone)]
 pub struct Grown<'c, 'a> {
@@ -406,13 +380,18 @@ impl Grown<'_, '_> {
             let d_t = if d_t.is_finite() { d_t } else { 0.0 };
             distance.insert(top.face, d_t);
             // Label-setting (Dijkstra) from the new face over the distances it lowers: each
-            // face's distance falls at most once per added face. (A stack-order relaxation
-            // lowered the same faces many times over: 2.5M updates for a 5.7k-face patch.)
-            let mut front = BinaryHeap::from([Lowered {
-                d: d_t,
+            // face's distance falls at most once per added face (a stack-order relaxation
+            // lowers the same faces many times over; notes/scaling.md). Ordered like the
+            // growth heap: least distance first, then face id.
+            let mut front = BinaryHeap::from([Entry {
+                cost: d_t,
                 face: top.face,
+                version: 0,
             }]);
-            while let Some(Lowered { d: df, face: f }) = front.pop() {
+            while let Some(Entry {
+                cost: df, face: f, ..
+            }) = front.pop()
+            {
                 if distance.get(&f).is_some_and(|&d| d < df) {
                     continue;
                 }
@@ -422,7 +401,11 @@ impl Grown<'_, '_> {
                     let cand = df + (centroid(g) - cf).norm();
                     if cand < distance.get(&g).copied().unwrap_or(f64::INFINITY) {
                         distance.insert(g, cand);
-                        front.push(Lowered { d: cand, face: g });
+                        front.push(Entry {
+                            cost: cand,
+                            face: g,
+                            version: 0,
+                        });
                     }
                 }
             }
