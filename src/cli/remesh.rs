@@ -122,6 +122,12 @@ pub struct RemeshArgs {
     /// at a time.
     #[arg(long, default_value_t = RemeshOptions::default().batch)]
     pub batch: usize,
+    /// The most faces one region holds: a larger mesh is split into regions (recursive
+    /// coordinate bisection) that are remeshed at the same time with their cuts frozen, then
+    /// the bands around the cuts are remeshed. The output depends on this number and the
+    /// seed, not on the thread count; 0 = one region (the paper's loop on the whole mesh).
+    #[arg(long, default_value_t = RemeshOptions::default().region_faces)]
+    pub region_faces: usize,
     /// Worker threads (default: RAYON_NUM_THREADS when set, else one per core). The output is
     /// the same for every thread count.
     #[arg(long)]
@@ -516,6 +522,7 @@ pub fn options(args: &RemeshArgs) -> RemeshOptions {
         max_patches: args.max_patches,
         sweeps: args.sweeps,
         batch: args.batch,
+        region_faces: args.region_faces,
         corner_defect: (args.corner_defect != 0.0).then_some(args.corner_defect),
         features: args.feature_angle,
         crease_metric: args.crease_metric,

@@ -30,6 +30,20 @@ impl VertexFactors {
         self.0.get(v.idx()).copied().unwrap_or(1.0)
     }
 
+    /// Cover one more vertex, with factor `f` (a region's new vertex as the regions are
+    /// merged).
+    pub fn push(&mut self, f: f64) {
+        self.0.push(f);
+    }
+
+    /// Keep the larger of the factor at `v` and `f` (a region's factor at one of the whole
+    /// mesh's vertices).
+    pub fn raise(&mut self, v: VertexId, f: f64) {
+        if let Some(x) = self.0.get_mut(v.idx()) {
+            *x = x.max(f);
+        }
+    }
+
     /// Number of vertices covered.
     pub fn len(&self) -> usize {
         self.0.len()

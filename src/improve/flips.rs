@@ -92,7 +92,12 @@ fn one_flip_pass(
     }
     let mut edges: Vec<EdgeKey> = edge_faces
         .iter()
-        .filter(|(e, fs)| fs.len() == 2 && !ctx.feature_edges.is_some_and(|fe| fe.contains(e)))
+        .filter(|(e, fs)| {
+            fs.len() == 2
+                && !ctx.feature_edges.is_some_and(|fe| fe.contains(e))
+                && ctx.in_scope(e.0)
+                && ctx.in_scope(e.1)
+        })
         .map(|(e, _)| *e)
         .collect();
     edges.sort();

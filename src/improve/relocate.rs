@@ -51,6 +51,7 @@ pub fn vertex_position_update(ctx: &SurfaceContext<'_>, work: &mut WorkingMesh) 
             if state.settled[vi]
                 || topo.vertex_faces(v).is_empty()
                 || ctx.pinned.get(vi).copied().unwrap_or(false)
+                || !ctx.in_scope(v)
             {
                 continue;
             }

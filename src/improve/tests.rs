@@ -20,6 +20,7 @@ fn ctx<'a>(
         pinned: &[],
         curves: None,
         slide_boundary: false,
+        scope: None,
     }
 }
 

@@ -70,7 +70,7 @@ pub fn patch_domain(
         eps: ctx.plan.eps,
         max_pieces: ctx.plan.patch_face_cap(),
     };
-    let chains = free_chains(&ctx.curves, work, topo, disk);
+    let chains = free_chains(&ctx.curves, ctx.frozen.as_deref(), work, topo, disk);
     if chains.is_empty() {
         return unchanged();
     }
@@ -172,9 +172,11 @@ fn is_mesh_boundary_edge(mesh: &TriMesh, topo: &Topology, a: VertexId, b: Vertex
     has(a, b) && !has(b, a)
 }
 
-/// The free chains of the patch loop (module docs).
+/// The free chains of the patch loop (module docs). In a region's run its cut edges are no
+/// chain's and its cut vertices anchors: the cuts stay as they are.
 fn free_chains(
     curves: &BoundaryCurves,
+    frozen: Option<&super::context::FrozenCut>,
     work: &WorkingMesh,
     topo: &Topology,
     disk: &PatchMesh,
@@ -183,7 +185,10 @@ fn free_chains(
     let n = b.len();
     let g = |i: usize| disk.to_global[b[i % n].idx()];
     let boundary_edge: Vec<bool> = (0..n)
-        .map(|i| is_mesh_boundary_edge(&work.mesh, topo, g(i), g(i + 1)))
+        .map(|i| {
+            is_mesh_boundary_edge(&work.mesh, topo, g(i), g(i + 1))
+                && !frozen.is_some_and(|c| c.is_cut_edge(g(i), g(i + 1)))
+        })
         .collect();
     if !boundary_edge.iter().any(|e| *e) {
         return Vec::new();
@@ -192,6 +197,7 @@ fn free_chains(
         let i = i % n;
         boundary_edge[i]
             && boundary_edge[(i + n - 1) % n]
+            && !frozen.is_some_and(|c| c.is_cut_vertex(g(i)))
             && work
                 .curve
                 .get(g(i).idx())

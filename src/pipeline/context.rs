@@ -17,6 +17,7 @@ use crate::patches::PatchContext;
 use crate::stitch::WorkingMesh;
 use nalgebra::Vector3;
 use std::collections::HashSet;
+use std::sync::Arc;
 
 /// What every patch of a run reads: the metric, the plan, the stages, and what was certified
 /// or derived from the input once.
@@ -31,17 +32,18 @@ pub struct RunContext<'a> {
     pub improvers: &'a [Box<dyn Improver>],
     /// The flip certificate against the reference (shared with the contexts of Algorithm 2's
     /// passes, which would otherwise index the reference again).
-    pub flip_test: std::sync::Arc<FlipTest>,
-    /// Area-weighted vertex normals of the reference (the fidelity control's).
-    pub ref_normals: Vec<Vector3<f64>>,
+    pub flip_test: Arc<FlipTest>,
+    /// Area-weighted vertex normals of the reference (the fidelity control's; shared with
+    /// the regions' contexts).
+    pub ref_normals: Arc<Vec<Vector3<f64>>>,
     /// Self-intersecting face pairs of the input (0 when not checked).
     pub input_pairs: usize,
     /// Candidates are checked for local self-intersections: the check is on and the input
     /// is embedded (an input that self-intersects cannot be replaced by an embedded surface
     /// on it).
     pub embedded_input: bool,
-    /// The input's topology, certified an oriented manifold.
-    pub reference_topology: Topology,
+    /// The input's topology, certified an oriented manifold (shared with the regions').
+    pub reference_topology: Arc<Topology>,
     /// The topology every working mesh must keep.
     pub signature: TopologySignature,
     /// The input's boundary edges.
@@ -53,6 +55,33 @@ pub struct RunContext<'a> {
     pub curves: BoundaryCurves,
     /// Algorithm 2 runs (its patches keep their boundary chains as they are).
     pub improving: bool,
+    /// In a region's run: its cuts, kept bit for bit ([`super::regions`]); `None` in the
+    /// run on the whole mesh.
+    pub frozen: Option<Arc<FrozenCut>>,
+}
+
+/// The cuts of a region's run ([`super::regions`]): the edges where the region meets the
+/// others, which no patch, chain or pass may change, and their vertices, which are corners.
+#[derive(Clone, Debug, Default)]
+pub struct FrozenCut {
+    /// The cut edges, by the region's vertex ids, sorted.
+    pub edges: Vec<EdgeKey>,
+    /// `vertices[v]`: the region's vertex `v` lies on a cut (past the end: a new vertex).
+    pub vertices: Vec<bool>,
+    /// Where each of the region's vertices was when the region's run started.
+    pub positions: Vec<nalgebra::Point3<f64>>,
+}
+
+impl FrozenCut {
+    /// `a`–`b` is a cut edge.
+    pub fn is_cut_edge(&self, a: VertexId, b: VertexId) -> bool {
+        self.edges.binary_search(&EdgeKey::new(a, b)).is_ok()
+    }
+
+    /// `v` lies on a cut.
+    pub fn is_cut_vertex(&self, v: VertexId) -> bool {
+        self.vertices.get(v.idx()).copied().unwrap_or(false)
+    }
 }
 
 impl<'a> RunContext<'a> {
@@ -86,15 +115,16 @@ impl<'a> RunContext<'a> {
             plan,
             stages: stages.loop_stages(),
             improvers: &stages.improvers,
-            flip_test: std::sync::Arc::new(FlipTest::new(reference)),
-            ref_normals: reference.area_weighted_normals(),
+            flip_test: Arc::new(FlipTest::new(reference)),
+            ref_normals: Arc::new(reference.area_weighted_normals()),
             input_pairs,
             embedded_input: o.check_self_intersections && input_pairs == 0,
             signature: TopologySignature::of(&reference_topology),
             input_boundary: invariants::boundary_edges(&reference_topology),
-            reference_topology,
+            reference_topology: Arc::new(reference_topology),
             corners,
             improving: false,
+            frozen: None,
         }
     }
 
@@ -116,6 +146,7 @@ impl<'a> RunContext<'a> {
             corners: self.corners.clone(),
             curves: self.curves.clone(),
             improving: true,
+            frozen: self.frozen.clone(),
         }
     }
 
@@ -164,6 +195,9 @@ pub struct LoopState {
     pub face_patch: Vec<Option<PatchId>>,
     /// Faces of the working mesh when the loop started (one sweep's work).
     pub faces_per_sweep: usize,
+    /// The share of the run's expected output this loop makes (1; a region's faces over
+    /// the whole mesh's in a region's run), which scales its budgets.
+    pub budget_share: f64,
     /// The current sweep (1-based).
     pub sweep: usize,
     /// Patches done (Algorithm 1's and the improvers').
@@ -197,6 +231,12 @@ pub struct LoopState {
     /// `blocked[f]` while a batch is chosen: face `f` shares a vertex with a patch already in
     /// the batch ([`PatchContext::blocked`]); empty between batches.
     pub blocked: Vec<bool>,
+    /// Regions the loop ran in, and the first patch of the band's loop after them (`None`:
+    /// one region).
+    pub regions: Option<(usize, usize)>,
+    /// The vertices the improvers may change (the bands around the regions' cuts, after the
+    /// regions' runs; past the end: vertices made since, in scope); `None`: all.
+    pub scope: Option<Vec<bool>>,
     /// Where the working mesh's faces lie, for the candidates' self-intersection certificate
     /// (when the input is embedded); built again before each pass of patches
     /// ([`LoopState::index_faces`]).
@@ -253,7 +293,7 @@ impl LoopState {
             })
             .collect();
         let topo = match features.edges.is_empty() {
-            true => ctx.reference_topology.clone(),
+            true => (*ctx.reference_topology).clone(),
             false => {
                 // The stage's certificate: the collapses kept an oriented manifold without
                 // degenerate faces (exact) and the input's topology.
@@ -272,11 +312,24 @@ impl LoopState {
             .iter()
             .map(|l| a_priori_at(&ctx.plan.fid_scale, reference, l))
             .collect();
-        Ok(LoopState {
+        Ok(LoopState::from_parts(work, topo, features, pinned, bound))
+    }
+
+    /// A loop's state at its start: `work` (nothing processed by this loop yet, unless the
+    /// caller marks it), its topology, feature lines, pinned vertices and fidelity bounds.
+    pub fn from_parts(
+        work: WorkingMesh,
+        topo: Topology,
+        features: FeatureLines,
+        pinned: Vec<bool>,
+        bound: Vec<f64>,
+    ) -> LoopState {
+        LoopState {
             bound,
             factors: VertexFactors::ones(work.mesh.n_vertices()),
             face_patch: vec![None; work.mesh.n_faces()],
             faces_per_sweep: work.mesh.n_faces(),
+            budget_share: 1.0,
             sweep: 1,
             patches: 0,
             loop_patches: 0,
@@ -292,12 +345,14 @@ impl LoopState {
             fallbacks: Fallbacks::default(),
             improvement: None,
             blocked: Vec::new(),
+            scope: None,
+            regions: None,
             near: None,
             work,
             topo,
             features,
             pinned,
-        })
+        }
     }
 
     /// Algorithm 1's loop condition: true while an unprocessed face remains, starting a
@@ -325,8 +380,16 @@ impl LoopState {
     /// The work budget in faces handled: [`super::RemeshOptions::work_budget`] times the
     /// face budget's base.
     pub fn work_budget(&self, ctx: &RunContext<'_>) -> f64 {
-        let base = ctx.plan.expected_fidelity.max(self.faces_per_sweep as f64);
+        let base = self.expected_share(ctx).max(self.faces_per_sweep as f64);
         ctx.plan.options.work_budget * base
+    }
+
+    /// The expected output with the a-priori scaling, times this loop's share of it.
+    fn expected_share(&self, ctx: &RunContext<'_>) -> f64 {
+        match self.budget_share == 1.0 {
+            true => ctx.plan.expected_fidelity,
+            false => ctx.plan.expected_fidelity * self.budget_share,
+        }
     }
 
     /// Whether the run is over its work budget (no refinement, no further sweep, no improver
@@ -354,7 +417,7 @@ impl LoopState {
     /// refining without reaching its tolerance (a crease no feature line follows, cut by
     /// every chord), this bounds it, and the run ends `Ok` with a warning.
     pub fn note_face_budget(&mut self, ctx: &RunContext<'_>) {
-        let base = ctx.plan.expected_fidelity.max(self.faces_per_sweep as f64);
+        let base = self.expected_share(ctx).max(self.faces_per_sweep as f64);
         if !self.over_face_budget
             && self.work.mesh.n_faces() as f64 > ctx.plan.options.face_budget * base
         {

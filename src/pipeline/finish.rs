@@ -3,7 +3,9 @@
 
 use super::context::{LoopState, RunContext};
 use super::error::PipelineError;
-use super::records::{FaceSummary, RemeshReport, RemeshResult, SeamQuality, Sizes, Warning};
+use super::records::{
+    FaceSummary, RegionsReport, RemeshReport, RemeshResult, SeamQuality, Sizes, Warning,
+};
 use super::replace::certify_boundary;
 use crate::ids::{EdgeKey, PatchId, VertexId};
 use crate::invariants::{self, FacePair, InvariantError, Offenders, TopologySignature};
@@ -65,17 +67,21 @@ pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(),
     Ok(())
 }
 
-/// Every corner is still a vertex of the working mesh, where the input had it.
-fn certify_corners(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), PipelineError> {
+/// Every corner is still a vertex of the working mesh, where the input had it (in a region's
+/// run: where the region's run started).
+pub fn certify_corners(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), PipelineError> {
     let mesh = &state.work.mesh;
-    let reference = ctx.quality_field.reference();
+    let start = match &ctx.frozen {
+        Some(cut) => &cut.positions,
+        None => &ctx.quality_field.reference().positions,
+    };
     let mut used = vec![false; mesh.n_vertices()];
     mesh.triangles
         .iter()
         .flatten()
         .for_each(|v| used[v.idx()] = true);
     match (0..ctx.corners.len())
-        .find(|&v| ctx.corners[v] && (!used[v] || mesh.positions[v] != reference.positions[v]))
+        .find(|&v| ctx.corners[v] && (!used[v] || mesh.positions[v] != start[v]))
     {
         Some(v) => Err(PipelineError::CornerLost(VertexId::new(v))),
         None => Ok(()),
@@ -83,7 +89,7 @@ fn certify_corners(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), Pipeli
 }
 
 /// Every feature-line piece is still an edge of the working mesh, its vertices unmoved.
-fn certify_features(state: &LoopState) -> Result<(), PipelineError> {
+pub fn certify_features(state: &LoopState) -> Result<(), PipelineError> {
     let features = &state.features;
     if features.edges.is_empty() {
         return Ok(());
@@ -110,7 +116,6 @@ fn seam_quality(
     face_patch: &[Option<PatchId>],
     metrics: &[nalgebra::Matrix3<f64>],
 ) -> SeamQuality {
-    use crate::quality::{face_metric, triangle_quality};
     let mesh = &work.mesh;
     let topo = Topology::build(mesh);
     let mut seam = vec![false; mesh.n_faces()];
@@ -123,10 +128,20 @@ fn seam_quality(
             }
         }
     }
-    let summary = |on: bool| {
+    split_quality(mesh, metrics, &seam)
+}
+
+/// The faces flagged in `on` against the others, in the unscaled metric.
+fn split_quality(
+    mesh: &crate::mesh::TriMesh,
+    metrics: &[nalgebra::Matrix3<f64>],
+    on: &[bool],
+) -> SeamQuality {
+    use crate::quality::{face_metric, triangle_quality};
+    let summary = |flag: bool| {
         let qs: Vec<_> = mesh
             .faces()
-            .filter(|f| seam[f.idx()] == on)
+            .filter(|f| on[f.idx()] == flag)
             .map(|f| triangle_quality(mesh.face_points(f), &face_metric(metrics, mesh.face(f))))
             .collect();
         let n = qs.len();
@@ -231,7 +246,17 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
             output_pairs: cert.self_intersecting_pairs,
         });
     }
-    let seams = seam_quality(&state.work, &state.face_patch, &state.vertex_metrics(ctx));
+    let metrics = state.vertex_metrics(ctx);
+    let seams = seam_quality(&state.work, &state.face_patch, &metrics);
+    let regions = RegionsReport {
+        count: state.regions.map_or(1, |r| r.0),
+        cuts: state.regions.map(|(_, band_from)| {
+            let band: Vec<bool> = (state.face_patch.iter())
+                .map(|p| p.is_some_and(|p| p.idx() >= band_from))
+                .collect();
+            split_quality(&state.work.mesh, &metrics, &band)
+        }),
+    };
     let sizes = sizes_on_target(ctx, &state);
     let out_topo = Topology::build(&state.work.mesh);
     let boundary_distance = crate::boundary::curve_distance(
@@ -243,6 +268,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
     let report = RemeshReport {
         improvement: state.improvement,
         seams,
+        regions,
         sizes,
         boundary_distance,
         options: plan.options.clone(),

@@ -48,6 +48,7 @@ impl ImproveRun for Host<'_> {
             pinned: &state.pinned,
             curves: Some(&ctx.curves),
             slide_boundary: o.boundary.resample,
+            scope: state.scope.as_deref(),
         };
         (surface, &mut state.work)
     }

@@ -17,6 +17,10 @@
 //! at the end: the whole mesh again, and no self-intersections (exact)
 //! ```
 //!
+//! A mesh larger than [`RemeshOptions::region_faces`] runs the loop and the improvers on
+//! regions at the same time first, their cuts frozen, and then the loop above on the bands
+//! around the cuts (`regions.rs`).
+//!
 //! [`remesh`] runs in the unit-diagonal space of the metric field's reference mesh
 //! ([`crate::metric::Normalization`]); [`Remesher`] does the whole job from a mesh in file
 //! units (scaling, the curvature or user metric, mapping back, re-certification).
@@ -36,6 +40,7 @@ mod finish;
 mod improvement;
 mod options;
 mod records;
+mod regions;
 mod remesher;
 mod replace;
 mod sizing;
@@ -48,8 +53,10 @@ pub use options::{
 };
 pub use records::{
     AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,
-    PatchRecord, PhaseTimes, Progress, RemeshReport, RemeshResult, StageTimes, Warning,
+    PatchRecord, PhaseTimes, Progress, RegionsReport, RemeshReport, RemeshResult, StageTimes,
+    Warning,
 };
+pub use regions::{partition, BAND_RINGS, DEFAULT_REGION_FACES};
 pub use remesher::{Remeshed, Remesher};
 pub use sizing::{
     coarse_input_estimate, expected_faces, Plan, MAX_EXPECTED_FACES, MIN_PATCH_FACE_CAP,
@@ -82,19 +89,24 @@ pub fn remesh(
     let plan = Plan::resolve(field, &topo, options)?;
     let ctx = RunContext::new(plan.quality_field(field), topo, &plan, stages);
     let mut state = LoopState::new(&ctx)?;
-    state.index_faces(&ctx);
     let mut rng = crate::Rng::seed_from_u64(plan.options.seed);
     state.wall.setup = clock.elapsed().as_secs_f64();
     let clock = Instant::now();
-    while state.face_remains(&ctx) {
-        let batch = next_batch(&ctx, &mut state, &mut rng)?; // (a) Sec. 3.2, a vertex apart
-        let outcomes = step::batch_steps(&ctx, &state, &batch, &mut rng)?; // (b)-(e), at the same time
-        replace::replace_batch(&ctx, &mut state, outcomes)?; // replace each P, update M
-        state.note_face_budget(&ctx); // past it, no more refinement: the run's cost is bounded
-        state.note_work_budget(&ctx); // past it, no refinement and then no further patch
-        state.batches += 1;
+    // Regions at the same time, their cuts frozen; then the loop below remeshes the bands
+    // around the cuts. One region (the default below RemeshOptions::region_faces): the loop
+    // runs on the whole mesh, as in the paper.
+    let regions = regions::run_regions(&ctx, &mut state)?;
+    if regions > 1 {
         on_progress(state.progress(&ctx));
-        options.cancel.check(state.patches)?;
+    }
+    let band_from = state.patches;
+    state.wall.regions = clock.elapsed().as_secs_f64();
+    let clock = Instant::now();
+    state.index_faces(&ctx);
+    patch_loop(&ctx, &mut state, &mut rng, &mut on_progress)?;
+    if regions > 1 {
+        regions::scope_band(&mut state, band_from);
+        state.regions = Some((regions, band_from));
     }
     state.loop_patches = state.patches;
     state.wall.patch_loop = clock.elapsed().as_secs_f64();
@@ -106,6 +118,28 @@ pub fn remesh(
     finish::certify_output(&ctx, &mut state)?;
     state.wall.finish = clock.elapsed().as_secs_f64();
     Ok(finish::into_result(&ctx, state))
+}
+
+/// Algorithm 1's loop: batches of patches until no unprocessed face remains (or a budget
+/// ends it), each replaced in the working mesh and certified.
+fn patch_loop(
+    ctx: &RunContext<'_>,
+    state: &mut LoopState,
+    rng: &mut crate::Rng,
+    on_progress: &mut dyn FnMut(Progress),
+) -> Result<(), PipelineError> {
+    let options = &ctx.plan.options;
+    while state.face_remains(ctx) {
+        let batch = next_batch(ctx, state, rng)?; // (a) Sec. 3.2, a vertex apart
+        let outcomes = step::batch_steps(ctx, state, &batch, rng)?; // (b)-(e), at the same time
+        replace::replace_batch(ctx, state, outcomes)?; // replace each P, update M
+        state.note_face_budget(ctx); // past it, no more refinement: the run's cost is bounded
+        state.note_work_budget(ctx); // past it, no refinement and then no further patch
+        state.batches += 1;
+        on_progress(state.progress(ctx));
+        options.cancel.check(state.patches)?;
+    }
+    Ok(())
 }
 
 /// The input must be an oriented 2-manifold (with or without boundary): say so up front,

@@ -87,6 +87,14 @@ pub struct RemeshOptions {
     /// and the seed, never on the thread count. 1 = one patch at a time (the paper). Default
     /// [`DEFAULT_BATCH`].
     pub batch: usize,
+    /// The most faces of the working mesh one region holds (ours; see the [`super`] module
+    /// docs and paper-notes "Regions"): a larger mesh is split into regions of at most this
+    /// many faces by recursive coordinate bisection, which run Algorithm 1 and the improvers
+    /// at the same time with their cuts frozen, and the bands around the cuts are remeshed
+    /// after. The output depends on this number and the seed, never on the thread count.
+    /// 0 = one region (the paper's loop on the whole mesh). Default
+    /// [`DEFAULT_REGION_FACES`](super::DEFAULT_REGION_FACES).
+    pub region_faces: usize,
     /// The face budget, a multiple of the larger of the input's face count and the expected
     /// output (default [`FACE_BUDGET`]); past it the fidelity control stops refining and no
     /// further sweep starts (a warning, not an error).
@@ -193,6 +201,7 @@ impl Default for RemeshOptions {
             boundary: BoundaryOptions::default(),
             sizes: SizeOptions::default(),
             batch: DEFAULT_BATCH,
+            region_faces: super::DEFAULT_REGION_FACES,
             face_budget: FACE_BUDGET,
             work_budget: WORK_BUDGET,
             cancel: Cancel::default(),

@@ -18,7 +18,9 @@ use std::fmt;
 pub struct PhaseTimes {
     /// The input's certificates, the plan, the context and the working mesh before the loop.
     pub setup: f64,
-    /// Algorithm 1's loop over patches.
+    /// The regions' runs at the same time, and their merge (0 with one region).
+    pub regions: f64,
+    /// Algorithm 1's loop over patches (with regions: over the bands around the cuts).
     pub patch_loop: f64,
     /// The improvers after the loop (Sec. 3.4).
     pub improve: f64,
@@ -446,6 +448,16 @@ pub struct ImproverRecord {
     pub seconds: f64,
 }
 
+/// How the run was split into regions ([`RemeshReport::regions`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct RegionsReport {
+    /// Regions (1: the loop ran on the whole mesh).
+    pub count: usize,
+    /// With several: the faces the band's patches made, where the cuts were (`seam`), against
+    /// the regions' faces (`rest`), in the unscaled metric.
+    pub cuts: Option<SeamQuality>,
+}
+
 /// The faces touching a patch seam against the rest (see [`RemeshReport::seams`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct SeamQuality {
@@ -539,6 +551,8 @@ pub struct RemeshReport {
     pub warnings: Vec<Warning>,
     /// Faces along the seams between patches against the rest.
     pub seams: SeamQuality,
+    /// The regions the loop ran in ([`RemeshOptions::region_faces`]).
+    pub regions: RegionsReport,
     /// Edge lengths against L_tar, and where the fidelity tolerance set them.
     pub sizes: Sizes,
     /// Distances between the input's boundary curves and the output's boundary (unit space).

@@ -274,6 +274,9 @@ fn certify_after_batch(
 /// every corner kept ([`invariants::certify_boundary_on_curves`]); without resampling also
 /// the input's boundary vertices and edges, bit for bit.
 pub fn certify_boundary(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), InvariantError> {
+    if let Some(cut) = &ctx.frozen {
+        return certify_region_boundary(ctx, cut, state);
+    }
     if ctx.input_boundary.is_empty() {
         return Ok(());
     }
@@ -294,4 +297,58 @@ pub fn certify_boundary(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), I
         &state.work.mesh,
         &invariants::boundary_edges(&state.topo),
     )
+}
+
+/// A region's boundary after a patch or a pass: every cut edge still a boundary edge with
+/// its vertices where they were (bit for bit), and every other boundary vertex exactly on the
+/// input's boundary curves. (Once around each curve, with its corners, is the whole mesh's
+/// certificate after the merge.)
+fn certify_region_boundary(
+    ctx: &RunContext<'_>,
+    cut: &super::context::FrozenCut,
+    state: &LoopState,
+) -> Result<(), InvariantError> {
+    let mesh = &state.work.mesh;
+    let boundary = invariants::boundary_edges(&state.topo);
+    let missing: Vec<crate::ids::EdgeKey> = cut
+        .edges
+        .iter()
+        .copied()
+        .filter(|e| boundary.binary_search(e).is_err())
+        .collect();
+    if !missing.is_empty() {
+        return Err(InvariantError::BoundaryEdgesMissing(invariants::Offenders(
+            missing,
+        )));
+    }
+    let moved: Vec<VertexId> = (0..cut.vertices.len())
+        .filter(|&v| cut.vertices[v] && mesh.positions[v] != cut.positions[v])
+        .map(VertexId::new)
+        .collect();
+    if !moved.is_empty() {
+        return Err(InvariantError::BoundaryVerticesMoved(
+            invariants::Offenders(moved),
+        ));
+    }
+    let reference = ctx.quality_field.reference();
+    let mut off: Vec<VertexId> = boundary
+        .iter()
+        .filter(|e| !cut.is_cut_edge(e.0, e.1))
+        .flat_map(|e| [e.0, e.1])
+        .filter(
+            |&v| match state.work.curve.get(v.idx()).copied().flatten() {
+                Some(p) => {
+                    p.curve as usize >= ctx.curves.len()
+                        || ctx.curves.position(reference, &p) != mesh.positions[v.idx()]
+                }
+                None => true,
+            },
+        )
+        .collect();
+    off.sort_unstable();
+    off.dedup();
+    match off.is_empty() {
+        true => Ok(()),
+        false => Err(InvariantError::BoundaryOffCurve(invariants::Offenders(off))),
+    }
 }
