@@ -107,7 +107,7 @@ fn faces_on_former_cuts_are_as_good_as_the_rest() {
         .iter()
         .map(|_| Matrix3::from_diagonal(&nalgebra::Vector3::new(40000.0, 400.0, 400.0)))
         .collect();
-    let cases: [(&str, &TriMesh, Option<&[Matrix3<f64>]>); 2] = [
+    let cases: [Case; 2] = [
         ("bumpy sphere", &sphere, None),
         ("plate 100:1", &plate, Some(&aniso)),
     ];
@@ -140,6 +140,9 @@ fn faces_on_former_cuts_are_as_good_as_the_rest() {
         );
     }
 }
+
+/// A named input and its user metric, if any.
+type Case<'a> = (&'a str, &'a TriMesh, Option<&'a [Matrix3<f64>]>);
 
 fn q_avg(r: &Remeshed) -> f64 {
     let s = &r.unit.report.seams;

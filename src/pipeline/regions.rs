@@ -249,10 +249,10 @@ fn run_region(
             .collect()
     };
     let corners = from_whole(&ctx.corners);
-    let mut rctx = RunContext {
+    let rctx = RunContext {
         quality_field: ctx.quality_field,
         plan: ctx.plan,
-        stages: ctx.stages.clone(),
+        stages: ctx.stages,
         improvers: ctx.improvers,
         flip_test: ctx.flip_test.clone(),
         ref_normals: ctx.ref_normals.clone(),
@@ -263,10 +263,9 @@ fn run_region(
         input_boundary: invariants::boundary_edges(&topo),
         corners,
         curves: ctx.curves.clone(),
-        improving: false,
+        improving: ctx.improving,
         frozen: Some(cut.clone()),
     };
-    rctx.improving = ctx.improving;
     let features = region_features(&whole.features, &region);
     let pinned = from_whole(&whole.pinned);
     let bound = region.whole.iter().map(|v| whole.bound[v.idx()]).collect();
@@ -382,12 +381,10 @@ fn merge(ctx: &RunContext<'_>, state: &mut LoopState, runs: Vec<RegionRun>) {
             state.pinned.push(false);
             state.factors.push(rs.factors.get(VertexId::new(l)));
         }
-        for l in 0..n0 {
-            state
-                .factors
-                .raise(map[l], rs.factors.get(VertexId::new(l)));
+        for (l, &v) in map.iter().enumerate().take(n0) {
+            state.factors.raise(v, rs.factors.get(VertexId::new(l)));
             if region.cut.vertices[l] {
-                cut_vertices.push(map[l]);
+                cut_vertices.push(v);
             }
         }
         let offset = state.patches;
