@@ -231,6 +231,10 @@ pub struct LoopState {
     /// `blocked[f]` while a batch is chosen: face `f` shares a vertex with a patch already in
     /// the batch ([`PatchContext::blocked`]); empty between batches.
     pub blocked: Vec<bool>,
+    /// Where this loop's streams start: 0 for the run on the whole mesh (a batch's patch in
+    /// slot `s` draws stream `s + 1`), `(r + 1) · 2³²` for region r's loop
+    /// ([`super::regions`]), so no two loops share a stream.
+    pub streams: u64,
     /// Regions the loop ran in, and the first patch of the band's loop after them (`None`:
     /// one region).
     pub regions: Option<(usize, usize)>,
@@ -346,6 +350,7 @@ impl LoopState {
             improvement: None,
             blocked: Vec::new(),
             scope: None,
+            streams: 0,
             regions: None,
             near: None,
             work,

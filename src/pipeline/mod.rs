@@ -91,23 +91,16 @@ pub fn remesh(
     let mut state = LoopState::new(&ctx)?;
     let mut rng = crate::Rng::seed_from_u64(plan.options.seed);
     state.wall.setup = clock.elapsed().as_secs_f64();
-    let clock = Instant::now();
-    // Regions at the same time, their cuts frozen; then the loop below remeshes the bands
-    // around the cuts. One region (the default below RemeshOptions::region_faces): the loop
-    // runs on the whole mesh, as in the paper.
+    // Regions at the same time, their cuts frozen, then the band around the cuts in pieces;
+    // the loop below takes what they left. One region (a mesh no larger than
+    // RemeshOptions::region_faces): the loop runs on the whole mesh, as in the paper.
     let regions = regions::run_regions(&ctx, &mut state)?;
     if regions > 1 {
         on_progress(state.progress(&ctx));
     }
-    let band_from = state.patches;
-    state.wall.regions = clock.elapsed().as_secs_f64();
     let clock = Instant::now();
     state.index_faces(&ctx);
     patch_loop(&ctx, &mut state, &mut rng, &mut on_progress)?;
-    if regions > 1 {
-        regions::scope_band(&mut state, band_from);
-        state.regions = Some((regions, band_from));
-    }
     state.loop_patches = state.patches;
     state.wall.patch_loop = clock.elapsed().as_secs_f64();
     options.cancel.check(state.patches)?;

@@ -20,6 +20,9 @@ pub struct PhaseTimes {
     pub setup: f64,
     /// The regions' runs at the same time, and their merge (0 with one region).
     pub regions: f64,
+    /// The band around the regions' cuts: its strips, then its junctions, each level's
+    /// pieces at the same time (0 with one region).
+    pub band: f64,
     /// Algorithm 1's loop over patches (with regions: over the bands around the cuts).
     pub patch_loop: f64,
     /// The improvers after the loop (Sec. 3.4).

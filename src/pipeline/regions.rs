@@ -3,18 +3,21 @@
 //!
 //! ```text
 //! split the working mesh into regions of at most R faces (recursive coordinate bisection)
-//! for every region, at the same time:                                  // rayon
-//!     Algorithm 1 and the improvers on the region's faces alone, its cuts frozen
-//!     certify the region (manifold, oriented, topology, cuts kept, corners, feature lines)
-//! merge the regions by their vertices' ids in the whole mesh
-//! mark the band of BAND_RINGS rings around every cut unprocessed      // Algorithm 1 goes on
+//! three levels, each level's pieces at the same time (rayon), each piece:
+//!     Algorithm 1 and the improvers on the piece's faces alone, its cuts frozen
+//!     certify the piece (manifold, oriented, topology, cuts kept, corners, feature lines)
+//!   1. the regions
+//!   2. the band of BAND_RINGS rings around the cuts, less the junctions' discs, in strips
+//!   3. the junctions (where three regions or more met), with the strips' ends
+//! merge each level's pieces back by their vertices' ids in the whole mesh
+//! the improvers again where the strips and junctions were frozen; Algorithm 1 on what is left
 //! ```
 //!
 //! A region's run reads the whole run's plan, metric, reference surface, boundary curves and
 //! flip certificate (read-only, shared); only its working mesh is its own. Its cut edges are
 //! kept bit for bit: every cut vertex is a corner (pinned, an anchor of every boundary chain),
-//! and no cut edge is a chain's. Each region draws from its own ChaCha8 stream (the seed's,
-//! stream = region index + 1), so the output depends on the seed and R, not on the threads.
+//! and no cut edge is a chain's. Each region draws from its own ChaCha8 streams (the seed's,
+//! [`REGION_STREAMS`] apart), so the output depends on the seed and R, not on the threads.
 
 use super::context::{FrozenCut, LoopState, RunContext};
 use super::error::PipelineError;
@@ -33,6 +36,11 @@ use std::sync::Arc;
 /// its faces, small enough that a region's per-patch costs (stitching, certificates) stay
 /// bounded whatever the mesh's size.
 pub const DEFAULT_REGION_FACES: usize = 12_000;
+
+/// Streams per region: region r's loop draws ChaCha8 stream `(r + 1) · REGION_STREAMS`, and
+/// a batch's patch in slot s of it `(r + 1) · REGION_STREAMS + s + 1`, far from the whole
+/// run's (`s + 1`) and from every other region's.
+const REGION_STREAMS: u64 = 1 << 32;
 
 /// Rings of faces around every cut that Algorithm 1 remeshes again after the merge: the
 /// regions' patches grade from the cut's input edges to the target size within about two.
@@ -197,10 +205,22 @@ pub struct RegionRun {
     state: LoopState,
 }
 
+/// The levels of a run with regions; each level's regions draw their own streams.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Level {
+    /// The regions of the partition, every face unprocessed.
+    Regions = 0,
+    /// The band around the cuts, in pieces split at the junctions.
+    Strips = 1,
+    /// The junctions, where three or more regions met, with the ends of the strips.
+    Junctions = 2,
+}
+
 /// Split the whole run's working mesh into regions when it is larger than
-/// [`super::RemeshOptions::region_faces`], run them at the same time, merge them into `state`
-/// and leave the band around the cuts unprocessed for the loop that follows. Returns the
-/// number of regions (1: nothing was done, the loop runs on the whole mesh as in the paper).
+/// [`super::RemeshOptions::region_faces`] and remesh it in three levels of independent
+/// pieces, each level's at the same time: the regions, then the band around their cuts split
+/// at the junctions into strips, then the junctions. Returns the number of regions (1:
+/// nothing was done, the loop runs on the whole mesh as in the paper).
 pub fn run_regions(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<usize, PipelineError> {
     let o = &ctx.plan.options;
     // A patch budget counts the run's patches in order; regions would spend it at once.
@@ -211,25 +231,238 @@ pub fn run_regions(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<usize,
     if parts.len() < 2 {
         return Ok(1);
     }
-    let mut region_of = vec![0u32; state.work.mesh.n_faces()];
-    for (r, faces) in parts.iter().enumerate() {
+    let clock = std::time::Instant::now();
+    state.work.processed.iter_mut().for_each(|p| *p = false);
+    let cuts = run_groups(ctx, state, &parts, Level::Regions)?;
+    state.wall.regions = clock.elapsed().as_secs_f64();
+    let clock = std::time::Instant::now();
+    let band_from = state.patches;
+    // Junctions: vertices on the cuts of three regions or more.
+    let mut seen_in = vec![0u8; state.work.mesh.n_vertices()];
+    for region_cut in &cuts {
+        for v in region_cut {
+            seen_in[v.idx()] = seen_in[v.idx()].saturating_add(1);
+        }
+    }
+    let cut: Vec<VertexId> = cuts.iter().flatten().copied().collect();
+    let junctions: Vec<VertexId> = (0..seen_in.len())
+        .filter(|&v| seen_in[v] >= 3)
+        .map(VertexId::new)
+        .collect();
+    // The strips: the band minus the junctions' discs, in connected pieces.
+    let mesh = &state.work.mesh;
+    let band = faces_near(mesh, &cut, BAND_RINGS, 2);
+    let disc = faces_near(mesh, &junctions, JUNCTION_RINGS, 1);
+    let strip_faces: Vec<bool> = band.iter().zip(&disc).map(|(b, d)| *b && !d).collect();
+    let strips = components(mesh, &state.topo, &strip_faces);
+    // (Faces a level leaves out stay unprocessed, for the next level or the loop after.)
+    mark_unprocessed(&mut state.work.processed, &strip_faces);
+    let mut frozen = run_groups(ctx, state, &strips, Level::Strips)?;
+    // The junctions, with the strips' ends (their cuts there were frozen).
+    let mesh = &state.work.mesh;
+    let disc = faces_near(mesh, &junctions, JUNCTION_RINGS + BAND_RINGS, 1);
+    let discs = components(mesh, &state.topo, &disc);
+    mark_unprocessed(&mut state.work.processed, &disc);
+    frozen.extend(run_groups(ctx, state, &discs, Level::Junctions)?);
+    // What the strips and junctions kept frozen is where the improvers run once more (their
+    // vertices were pinned in every piece); the loop after takes any face still unprocessed.
+    let frozen: Vec<VertexId> = frozen.into_iter().flatten().collect();
+    let scope = vertices_near(&state.work.mesh, &frozen, 0);
+    state.scope = Some(scope);
+    state.sweep = o.sweeps.max(state.sweep);
+    state.regions = Some((parts.len(), band_from));
+    state.wall.band = clock.elapsed().as_secs_f64();
+    Ok(parts.len())
+}
+
+fn mark_unprocessed(processed: &mut [bool], on: &[bool]) {
+    for (p, o) in processed.iter_mut().zip(on) {
+        *p &= !o;
+    }
+}
+
+/// Rings of faces around the junctions that the strips leave out, and that the junctions'
+/// pieces remesh with [`BAND_RINGS`] more (the strips' ends).
+pub const JUNCTION_RINGS: usize = 8;
+
+/// `flags[v]` for the vertices within `rings` rings of `seeds`.
+fn vertices_near(mesh: &TriMesh, seeds: &[VertexId], rings: usize) -> Vec<bool> {
+    let mut near = vec![false; mesh.n_vertices()];
+    for v in seeds {
+        near[v.idx()] = true;
+    }
+    for _ in 0..rings {
+        let mut grown = near.clone();
+        for t in &mesh.triangles {
+            if t.iter().any(|v| near[v.idx()]) {
+                t.iter().for_each(|v| grown[v.idx()] = true);
+            }
+        }
+        near = grown;
+    }
+    near
+}
+
+/// `flags[f]` for the faces with at least `corners` vertices within `rings` rings of `seeds`.
+fn faces_near(mesh: &TriMesh, seeds: &[VertexId], rings: usize, corners: usize) -> Vec<bool> {
+    let near = vertices_near(mesh, seeds, rings);
+    mesh.triangles
+        .iter()
+        .map(|t| t.iter().filter(|v| near[v.idx()]).count() >= corners)
+        .collect()
+}
+
+/// The faces flagged in `on`, in pieces connected across edges, each in increasing id order,
+/// the pieces in the order of their smallest face.
+fn components(mesh: &TriMesh, topo: &Topology, on: &[bool]) -> Vec<Vec<FaceId>> {
+    let mut uf = UnionFind::new(mesh.n_faces());
+    for f in mesh.faces().filter(|f| on[f.idx()]) {
+        for k in 0..3 {
+            if let Some(g) = topo.neighbor(f, k).filter(|g| on[g.idx()]) {
+                uf.union(f.idx(), g.idx());
+            }
+        }
+    }
+    let mut piece_of: rustc_hash::FxHashMap<usize, usize> = Default::default();
+    let mut pieces: Vec<Vec<FaceId>> = Vec::new();
+    for f in mesh.faces().filter(|f| on[f.idx()]) {
+        let root = uf.find(f.idx());
+        let k = *piece_of.entry(root).or_insert_with(|| {
+            pieces.push(Vec::new());
+            pieces.len() - 1
+        });
+        pieces[k].push(f);
+    }
+    pieces
+}
+
+/// Leave out of their regions the faces that make a region touch itself at a vertex: at
+/// every vertex where a region's faces form two fans or more, the faces of all but the
+/// largest fan (ties: the one with the smallest face id) get `u32::MAX`, again until no such
+/// vertex is left (regions only shrink, so this ends).
+fn drop_pinches(mesh: &TriMesh, topo: &Topology, region_of: &mut [u32]) {
+    let mut check: Vec<VertexId> = mesh
+        .vertices()
+        .filter(|&v| {
+            let fs = topo.vertex_faces(v);
+            fs.iter()
+                .any(|f| region_of[f.idx()] != region_of[fs[0].idx()])
+        })
+        .collect();
+    while !check.is_empty() {
+        let mut next = Vec::new();
+        for &v in &check {
+            let fs = topo.vertex_faces(v);
+            let mut labels: Vec<u32> = fs
+                .iter()
+                .map(|f| region_of[f.idx()])
+                .filter(|r| *r != u32::MAX)
+                .collect();
+            labels.sort_unstable();
+            labels.dedup();
+            for r in labels {
+                let mine: Vec<FaceId> = fs
+                    .iter()
+                    .copied()
+                    .filter(|f| region_of[f.idx()] == r)
+                    .collect();
+                let fans = fans_at(mesh, v, &mine);
+                if fans.len() < 2 {
+                    continue;
+                }
+                let keep = (0..fans.len())
+                    .max_by_key(|&i| (fans[i].len(), std::cmp::Reverse(fans[i][0])))
+                    .unwrap_or(0);
+                for (_, fan) in fans.iter().enumerate().filter(|(i, _)| *i != keep) {
+                    for f in fan {
+                        region_of[f.idx()] = u32::MAX;
+                        next.extend(mesh.triangles[f.idx()]);
+                    }
+                }
+            }
+        }
+        next.sort_unstable();
+        next.dedup();
+        check = next;
+    }
+}
+
+/// The faces `faces` around vertex `v` in fans: joined when they share an edge at `v`; each
+/// fan's faces in increasing id order, the fans in the order of their smallest face.
+fn fans_at(mesh: &TriMesh, v: VertexId, faces: &[FaceId]) -> Vec<Vec<FaceId>> {
+    let mut sorted = faces.to_vec();
+    sorted.sort_unstable();
+    let mut uf = UnionFind::new(sorted.len());
+    let others = |f: FaceId| {
+        let t = mesh.triangles[f.idx()];
+        let k = t.iter().position(|w| *w == v).unwrap_or(0);
+        [t[(k + 1) % 3], t[(k + 2) % 3]]
+    };
+    for i in 0..sorted.len() {
+        for j in i + 1..sorted.len() {
+            let (a, b) = (others(sorted[i]), others(sorted[j]));
+            if a.iter().any(|x| b.contains(x)) {
+                uf.union(i, j);
+            }
+        }
+    }
+    let mut root_fan: Vec<(usize, usize)> = Vec::new();
+    let mut fans: Vec<Vec<FaceId>> = Vec::new();
+    for (i, &f) in sorted.iter().enumerate() {
+        let root = uf.find(i);
+        match root_fan.iter().find(|(r, _)| *r == root) {
+            Some(&(_, k)) => fans[k].push(f),
+            None => {
+                root_fan.push((root, fans.len()));
+                fans.push(vec![f]);
+            }
+        }
+    }
+    fans
+}
+
+/// Run disjoint face sets of the whole working mesh as regions at the same time, each with
+/// its cuts frozen, and merge them back. Returns, per group, the whole mesh's vertices on its
+/// cuts.
+fn run_groups(
+    ctx: &RunContext<'_>,
+    state: &mut LoopState,
+    groups: &[Vec<FaceId>],
+    level: Level,
+) -> Result<Vec<Vec<VertexId>>, PipelineError> {
+    if groups.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut region_of = vec![u32::MAX; state.work.mesh.n_faces()];
+    for (r, faces) in groups.iter().enumerate() {
         for f in faces {
             region_of[f.idx()] = r as u32;
         }
     }
+    // A region that touches itself at a vertex would have copies of it there, which the
+    // candidates' exact intersection test sees as two vertices at one point: the faces of
+    // its smaller fans there are left out (unprocessed, for a later level or the loop).
+    drop_pinches(&state.work.mesh, &state.topo, &mut region_of);
+    let mut kept: Vec<Vec<FaceId>> = vec![Vec::new(); groups.len()];
+    for (f, r) in region_of.iter().enumerate() {
+        if *r != u32::MAX {
+            kept[*r as usize].push(FaceId::new(f));
+        }
+    }
+    let groups = &kept;
     let whole_faces = state.work.mesh.n_faces() as f64;
-    let runs: Vec<RegionRun> = parts
+    let runs: Vec<RegionRun> = groups
         .par_iter()
         .enumerate()
         .map(|(r, faces)| {
             let region = extract(&state.work, &state.topo, &region_of, r as u32, faces);
             let share = faces.len() as f64 / whole_faces;
-            run_region(ctx, state, region, r, share)
+            // Stream blocks: 2²⁰ regions per level at most.
+            let index = ((level as usize) << 20) + r;
+            run_region(ctx, state, region, index, share, level == Level::Regions)
         })
         .collect::<Result<_, _>>()?;
-    let regions = runs.len();
-    merge(ctx, state, runs);
-    Ok(regions)
+    Ok(merge(state, &region_of, runs))
 }
 
 /// Algorithm 1 and the improvers on one region, and its certificates.
@@ -239,6 +472,7 @@ fn run_region(
     region: RegionMesh,
     index: usize,
     share: f64,
+    first_level: bool,
 ) -> Result<RegionRun, PipelineError> {
     let topo = Topology::build(&region.work.mesh);
     let cut = Arc::new(region.cut.clone());
@@ -271,10 +505,16 @@ fn run_region(
     let bound = region.whole.iter().map(|v| whole.bound[v.idx()]).collect();
     let mut state = LoopState::from_parts(region.work.clone(), topo, features, pinned, bound);
     state.budget_share = share;
-    state.sweep = whole.sweep;
+    // The further sweeps (the coarse-input profile) are the first level's; the strips and
+    // junctions remesh their pieces once.
+    state.sweep = match first_level {
+        true => whole.sweep,
+        false => ctx.plan.options.sweeps.max(whole.sweep),
+    };
     state.index_faces(&rctx);
+    state.streams = (index as u64 + 1) * REGION_STREAMS;
     let mut rng = crate::Rng::seed_from_u64(ctx.plan.options.seed);
-    rng.set_stream(index as u64 + 1);
+    rng.set_stream(state.streams);
     super::patch_loop(&rctx, &mut state, &mut rng, &mut |_| {})?;
     super::improvement::run(&rctx, &mut state, &mut rng)?;
     certify_region(&rctx, &mut state)?;
@@ -334,40 +574,24 @@ fn certify_region(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(), Pip
     Ok(())
 }
 
-/// After the band's loop: the improvers, which ran in the regions, run again on the band
-/// alone, widened to the faces the band's patches made (they reach past the band by their
-/// overlap rings) and [`BAND_RINGS`] rings around them.
-pub fn scope_band(state: &mut LoopState, band_from: usize) {
-    let mesh = &state.work.mesh;
-    let mut scope = state.scope.take().unwrap_or_default();
-    scope.resize(mesh.n_vertices(), false);
-    for (t, p) in mesh.triangles.iter().zip(&state.face_patch) {
-        if p.is_some_and(|p| p.idx() >= band_from) {
-            t.iter().for_each(|v| scope[v.idx()] = true);
-        }
-    }
-    for _ in 0..BAND_RINGS {
-        let mut grown = scope.clone();
-        for t in &mesh.triangles {
-            if t.iter().any(|v| scope[v.idx()]) {
-                t.iter().for_each(|v| grown[v.idx()] = true);
-            }
-        }
-        scope = grown;
-    }
-    state.scope = Some(scope);
-}
-
 /// Put the regions' meshes back into the whole: the whole mesh's vertices keep their ids
 /// (those the regions removed are left unreferenced, for the final compaction), each
-/// region's new vertices are appended in region order, and the faces are the regions' in
-/// region order. Everything kept in step with the working mesh follows, and the band of
-/// [`BAND_RINGS`] rings around the cuts is left unprocessed.
-fn merge(ctx: &RunContext<'_>, state: &mut LoopState, runs: Vec<RegionRun>) {
-    let mut triangles = Vec::new();
-    let mut face_patch = Vec::new();
-    let mut cut_vertices = Vec::new();
+/// region's new vertices are appended in region order; the faces in no region stay first, in
+/// their order, then the regions' faces in region order, processed. Everything kept in step
+/// with the working mesh follows. Returns, per region, the whole mesh's vertices on its cuts.
+fn merge(state: &mut LoopState, region_of: &[u32], runs: Vec<RegionRun>) -> Vec<Vec<VertexId>> {
     let w = &mut state.work;
+    let mut triangles = Vec::with_capacity(w.mesh.n_faces());
+    let mut processed = Vec::with_capacity(w.mesh.n_faces());
+    let mut face_patch = Vec::with_capacity(w.mesh.n_faces());
+    for (f, t) in w.mesh.triangles.iter().enumerate() {
+        if region_of[f] == u32::MAX {
+            triangles.push(*t);
+            processed.push(w.processed[f]);
+            face_patch.push(state.face_patch.get(f).copied().flatten());
+        }
+    }
+    let mut cuts = Vec::with_capacity(runs.len());
     for run in runs {
         let RegionRun { region, state: rs } = run;
         let n0 = region.whole.len();
@@ -381,12 +605,16 @@ fn merge(ctx: &RunContext<'_>, state: &mut LoopState, runs: Vec<RegionRun>) {
             state.pinned.push(false);
             state.factors.push(rs.factors.get(VertexId::new(l)));
         }
+        let mut on_cut = Vec::new();
         for (l, &v) in map.iter().enumerate().take(n0) {
             state.factors.raise(v, rs.factors.get(VertexId::new(l)));
             if region.cut.vertices[l] {
-                cut_vertices.push(v);
+                on_cut.push(v);
             }
         }
+        on_cut.sort_unstable();
+        on_cut.dedup();
+        cuts.push(on_cut);
         let offset = state.patches;
         triangles.extend(
             rs.work
@@ -395,6 +623,7 @@ fn merge(ctx: &RunContext<'_>, state: &mut LoopState, runs: Vec<RegionRun>) {
                 .iter()
                 .map(|t| t.map(|v| map[v.idx()])),
         );
+        processed.extend(std::iter::repeat_n(true, rs.work.mesh.n_faces()));
         face_patch.extend(
             rs.face_patch
                 .iter()
@@ -417,31 +646,10 @@ fn merge(ctx: &RunContext<'_>, state: &mut LoopState, runs: Vec<RegionRun>) {
         state.work_stopped |= rs.work_stopped;
     }
     w.mesh.triangles = triangles;
-    w.processed = vec![true; w.mesh.n_faces()];
+    w.processed = processed;
     state.face_patch = face_patch;
     state.topo = Topology::build(&w.mesh);
-    // The band: BAND_RINGS rings of faces around the cut vertices.
-    let mut near = vec![false; w.mesh.n_vertices()];
-    for v in &cut_vertices {
-        near[v.idx()] = true;
-    }
-    for _ in 0..BAND_RINGS {
-        let mut grown = near.clone();
-        for t in &w.mesh.triangles {
-            if t.iter().any(|v| near[v.idx()]) {
-                t.iter().for_each(|v| grown[v.idx()] = true);
-            }
-        }
-        near = grown;
-    }
-    for (f, t) in w.mesh.triangles.iter().enumerate() {
-        if t.iter().filter(|v| near[v.idx()]).count() >= 2 {
-            w.processed[f] = false;
-        }
-    }
-    state.scope = Some(near);
-    // The band is the last pass of the run: no further sweep starts after it.
-    state.sweep = ctx.plan.options.sweeps.max(state.sweep);
+    cuts
 }
 
 #[cfg(test)]
@@ -521,5 +729,52 @@ mod tests {
         }
         // The outer corners of the plate are on no cut.
         assert!((0..r.whole.len()).any(|l| !r.cut.vertices[l]));
+    }
+
+    /// After `drop_pinches` no region touches itself at a vertex, and only faces that were in
+    /// a region left it: on the 2×2 grid whose region 0 is two quads meeting at the centre, and
+    /// on a sphere's regions with one region's faces thinned out.
+    #[test]
+    fn drop_pinches_leaves_one_fan_per_region_at_every_vertex() {
+        let plate = generators::plate(1.0, 2);
+        let checker: Vec<u32> = plate
+            .faces()
+            .map(|f| {
+                let [a, b, c] = plate.face_points(f);
+                let m = (a.coords + b.coords + c.coords) / 3.0;
+                u32::from((m.x > 0.5) != (m.y > 0.5))
+            })
+            .collect();
+        let sphere = generators::icosphere(1.0, 3);
+        let mut thinned = vec![u32::MAX; sphere.n_faces()];
+        for (r, faces) in partition(&sphere, 200).iter().enumerate() {
+            for f in faces {
+                // Every third face of region 0 left out: pinches all over it.
+                if r != 0 || f.idx() % 3 != 0 {
+                    thinned[f.idx()] = r as u32;
+                }
+            }
+        }
+        for (mesh, before) in [(&plate, checker), (&sphere, thinned)] {
+            let topo = Topology::build(mesh);
+            let mut after = before.clone();
+            drop_pinches(mesh, &topo, &mut after);
+            for (b, a) in before.iter().zip(&after) {
+                assert!(a == b || *a == u32::MAX, "a face changed region");
+            }
+            for v in mesh.vertices() {
+                let fs = topo.vertex_faces(v);
+                for &f in fs {
+                    let r = after[f.idx()];
+                    if r == u32::MAX {
+                        continue;
+                    }
+                    let mine: Vec<FaceId> =
+                        fs.iter().copied().filter(|g| after[g.idx()] == r).collect();
+                    assert_eq!(fans_at(mesh, v, &mine).len(), 1, "{v}: region {r} pinched");
+                }
+            }
+            assert!(after.iter().any(|r| *r != u32::MAX));
+        }
     }
 }

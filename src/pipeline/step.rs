@@ -72,7 +72,7 @@ pub fn batch_steps(
     }
     let step = |k: usize, patch: &Patch| {
         let slot = state.patches + k;
-        let mut rng = patch_rng(ctx.plan.options.seed, slot);
+        let mut rng = patch_rng(ctx.plan.options.seed, state.streams + slot as u64);
         patch_step(ctx, state, PatchId::new(slot), patch, &mut rng)
     };
     let results: Vec<_> = match batch {
@@ -88,9 +88,9 @@ pub fn batch_steps(
 
 /// The RNG of the patch in slot `slot` of the loop (its id before deferrals): stream
 /// `slot + 1` of the run's seed (stream 0 is the patch strategy's).
-pub fn patch_rng(seed: u64, slot: usize) -> crate::Rng {
+pub fn patch_rng(seed: u64, slot: u64) -> crate::Rng {
     let mut rng = <crate::Rng as rand::SeedableRng>::seed_from_u64(seed);
-    rng.set_stream(slot as u64 + 1);
+    rng.set_stream(slot + 1);
     rng
 }
 
