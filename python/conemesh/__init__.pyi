@@ -53,7 +53,7 @@ def remesh(
     hausd: float = 0.0035,
     sweeps: int = 1,
     batch: int = 1,
-    region_faces: int = 12000,
+    region_faces: int = 6000,
     threads: int | None = None,
     corner_defect: float = 1.0,
     feature_angle: float | Literal["auto", "off"] = "auto",

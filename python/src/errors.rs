@@ -241,6 +241,16 @@ pub fn from_pipeline(e: &PipelineError) -> Failure {
             ..from_metric(m)
         },
         PipelineError::Input(_) => Failure::input(msg),
+        // The piece's failure decides the class; its ids are the piece's own, so they are
+        // in the message only, with the piece's place.
+        PipelineError::Region {
+            level,
+            index,
+            source,
+            ..
+        } => Failure::new(from_pipeline(source).class, msg)
+            .with("region_level", Attr::Str(level.to_string()))
+            .with("region", Attr::Int(*index as i64)),
         _ => Failure::new("RemeshError", msg),
     }
 }

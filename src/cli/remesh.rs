@@ -122,10 +122,11 @@ pub struct RemeshArgs {
     /// at a time.
     #[arg(long, default_value_t = RemeshOptions::default().batch)]
     pub batch: usize,
-    /// The most faces one region holds: a larger mesh is split into regions (recursive
-    /// coordinate bisection) that are remeshed at the same time with their cuts frozen, then
-    /// the bands around the cuts are remeshed. The output depends on this number and the
-    /// seed, not on the thread count; 0 = one region (the paper's loop on the whole mesh).
+    /// The most output faces one region is expected to make (each input face counting at
+    /// least 1/4): a larger job is split into regions (recursive coordinate bisection) that
+    /// are remeshed at the same time with their cuts frozen, then the bands around the cuts
+    /// are remeshed. The output depends on this number and the seed, not on the thread count;
+    /// 0 = one region (the paper's loop on the whole mesh).
     #[arg(long, default_value_t = RemeshOptions::default().region_faces)]
     pub region_faces: usize,
     /// Worker threads (default: RAYON_NUM_THREADS when set, else one per core). The output is

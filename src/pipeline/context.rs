@@ -235,6 +235,9 @@ pub struct LoopState {
     /// slot `s` draws stream `s + 1`), `(r + 1) · 2³²` for region r's loop
     /// ([`super::regions`]), so no two loops share a stream.
     pub streams: u64,
+    /// The regions were declined: this quantile of their cut edges' lengths (over L_tar) was
+    /// above [`crate::pipeline::MAX_CUT_EDGE`].
+    pub regions_declined: Option<f64>,
     /// Regions the loop ran in, and the first patch of the band's loop after them (`None`:
     /// one region).
     pub regions: Option<(usize, usize)>,
@@ -352,6 +355,7 @@ impl LoopState {
             scope: None,
             streams: 0,
             regions: None,
+            regions_declined: None,
             near: None,
             work,
             topo,

@@ -206,6 +206,19 @@ pub enum PipelineError {
         /// patches done when the stop was seen
         patches: usize,
     },
+    /// The run of one piece of a mesh split into regions failed (paper-notes "Regions"); the
+    /// patch, vertex, face and edge ids in `source` are the piece's own.
+    #[error("{level} {index} ({faces} faces; ids below are the piece's own): {source}")]
+    Region {
+        /// which level: "region", "strip" or "junction"
+        level: &'static str,
+        /// the piece's index in its level
+        index: usize,
+        /// its faces
+        faces: usize,
+        /// what failed there
+        source: Box<PipelineError>,
+    },
     /// An improver failed with an error of its own.
     #[error("improver `{improver}`: {message}")]
     Improver {

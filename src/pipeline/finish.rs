@@ -250,6 +250,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
     let seams = seam_quality(&state.work, &state.face_patch, &metrics);
     let regions = RegionsReport {
         count: state.regions.map_or(1, |r| r.0),
+        declined_cut_edge: state.regions_declined,
         cuts: state.regions.map(|(_, band_from)| {
             let band: Vec<bool> = (state.face_patch.iter())
                 .map(|p| p.is_some_and(|p| p.idx() >= band_from))

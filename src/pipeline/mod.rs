@@ -56,7 +56,9 @@ pub use records::{
     PatchRecord, PhaseTimes, Progress, RegionsReport, RemeshReport, RemeshResult, StageTimes,
     Warning,
 };
-pub use regions::{partition, BAND_RINGS, DEFAULT_REGION_FACES};
+pub use regions::{
+    partition, BAND_RINGS, CUT_QUANTILE, DEFAULT_REGION_FACES, MAX_CUT_EDGE, MIN_FACE_WEIGHT,
+};
 pub use remesher::{Remeshed, Remesher};
 pub use sizing::{
     coarse_input_estimate, expected_faces, Plan, MAX_EXPECTED_FACES, MIN_PATCH_FACE_CAP,

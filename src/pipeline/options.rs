@@ -87,12 +87,13 @@ pub struct RemeshOptions {
     /// and the seed, never on the thread count. 1 = one patch at a time (the paper). Default
     /// [`DEFAULT_BATCH`].
     pub batch: usize,
-    /// The most faces of the working mesh one region holds (ours; see the [`super`] module
-    /// docs and paper-notes "Regions"): a larger mesh is split into regions of at most this
-    /// many faces by recursive coordinate bisection, which run Algorithm 1 and the improvers
-    /// at the same time with their cuts frozen, and the bands around the cuts are remeshed
-    /// after. The output depends on this number and the seed, never on the thread count.
-    /// 0 = one region (the paper's loop on the whole mesh). Default
+    /// The most output faces one region is expected to make (ours; see the [`super`] module
+    /// docs and paper-notes "Regions"): a mesh expected to make more is split into regions by
+    /// recursive coordinate bisection, each face weighing the output faces it should make
+    /// (at least [`MIN_FACE_WEIGHT`](super::MIN_FACE_WEIGHT)); the regions run Algorithm 1
+    /// and the improvers at the same time with their cuts frozen, and the bands around the
+    /// cuts are remeshed after. The output depends on this number and the seed, never on the
+    /// thread count. 0 = one region (the paper's loop on the whole mesh). Default
     /// [`DEFAULT_REGION_FACES`](super::DEFAULT_REGION_FACES).
     pub region_faces: usize,
     /// The face budget, a multiple of the larger of the input's face count and the expected

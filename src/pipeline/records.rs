@@ -459,6 +459,11 @@ pub struct RegionsReport {
     /// With several: the faces the band's patches made, where the cuts were (`seam`), against
     /// the regions' faces (`rest`), in the unscaled metric.
     pub cuts: Option<SeamQuality>,
+    /// The mesh was large enough for regions, but the run kept one: the 90th percentile of
+    /// the cut edges' lengths, over L_tar in the metric, was this (above
+    /// [`MAX_CUT_EDGE`](crate::pipeline::MAX_CUT_EDGE): the input is coarser than the output
+    /// there, and frozen cuts would keep edges too long for it).
+    pub declined_cut_edge: Option<f64>,
 }
 
 /// The faces touching a patch seam against the rest (see [`RemeshReport::seams`]).

@@ -31,11 +31,11 @@ use rand::SeedableRng;
 use rayon::prelude::*;
 use std::sync::Arc;
 
-/// The default of [`super::RemeshOptions::region_faces`]: the most faces of the working mesh
-/// one region holds. Large enough that a region's patches are far from its cuts for most of
-/// its faces, small enough that a region's per-patch costs (stitching, certificates) stay
-/// bounded whatever the mesh's size.
-pub const DEFAULT_REGION_FACES: usize = 12_000;
+/// The default of [`super::RemeshOptions::region_faces`]: the most output faces one region
+/// is expected to make ([`face_weights`]). Large enough that a region's patches are far from
+/// its cuts for most of its faces, small enough that a region's per-patch costs (stitching,
+/// certificates) stay bounded whatever the mesh's size.
+pub const DEFAULT_REGION_FACES: usize = 6_000;
 
 /// Streams per region: region r's loop draws ChaCha8 stream `(r + 1) · REGION_STREAMS`, and
 /// a batch's patch in slot s of it `(r + 1) · REGION_STREAMS + s + 1`, far from the whole
@@ -44,16 +44,23 @@ const REGION_STREAMS: u64 = 1 << 32;
 
 /// Rings of faces around every cut that Algorithm 1 remeshes again after the merge: the
 /// regions' patches grade from the cut's input edges to the target size within about two.
-pub const BAND_RINGS: usize = 3;
+pub const BAND_RINGS: usize = 5;
 
-/// The faces of `mesh` split into regions of at most `max_faces` faces by recursive
-/// coordinate bisection of the face centroids: each split halves a set along the longest side
-/// of its centroids' bounding box (ties broken by face id), so the regions depend on the mesh
-/// and `max_faces` only. Each region's faces are in increasing id order. One region holding
-/// every face when `max_faces` is 0 or the mesh is no larger.
-pub fn partition(mesh: &TriMesh, max_faces: usize) -> Vec<Vec<FaceId>> {
+/// The least weight an input face counts for in [`partition`]'s bound ([`face_weights`]): a
+/// region holds at most 1/`MIN_FACE_WEIGHT` times the bound in input faces, however coarse
+/// the output there.
+pub const MIN_FACE_WEIGHT: f64 = 0.25;
+
+/// The faces of `mesh` split into regions of weight at most `max_weight` by recursive
+/// coordinate bisection of the face centroids: each split cuts a set at its weighted median
+/// along the longest side of its centroids' bounding box (ties broken by face id), so the
+/// regions depend on the mesh, the weights and the bound only. Each region's faces are in
+/// increasing id order. One region holding every face when `max_weight` is 0 or the whole
+/// weight is no more.
+pub fn partition(mesh: &TriMesh, weights: &[f64], max_weight: f64) -> Vec<Vec<FaceId>> {
     let all: Vec<FaceId> = mesh.faces().collect();
-    if max_faces == 0 || all.len() <= max_faces {
+    let total: f64 = weights.iter().sum();
+    if max_weight <= 0.0 || total <= max_weight || all.len() < 2 {
         return vec![all];
     }
     let centroids: Vec<Point3<f64>> = mesh
@@ -64,7 +71,7 @@ pub fn partition(mesh: &TriMesh, max_faces: usize) -> Vec<Vec<FaceId>> {
         })
         .collect();
     let mut out = Vec::new();
-    bisect(&centroids, all, max_faces, &mut out);
+    bisect(&centroids, weights, all, max_weight, &mut out);
     for r in &mut out {
         r.sort_unstable();
     }
@@ -73,11 +80,13 @@ pub fn partition(mesh: &TriMesh, max_faces: usize) -> Vec<Vec<FaceId>> {
 
 fn bisect(
     centroids: &[Point3<f64>],
+    weights: &[f64],
     mut faces: Vec<FaceId>,
-    max: usize,
+    max: f64,
     out: &mut Vec<Vec<FaceId>>,
 ) {
-    if faces.len() <= max {
+    let total: f64 = faces.iter().map(|f| weights[f.idx()]).sum();
+    if total <= max || faces.len() < 2 {
         out.push(faces);
         return;
     }
@@ -90,15 +99,54 @@ fn bisect(
     }
     let ext = hi - lo;
     let axis = (0..3).fold(0, |a, k| if ext[k] > ext[a] { k } else { a });
-    let mid = faces.len() / 2;
-    faces.select_nth_unstable_by(mid, |a, b| {
+    faces.sort_unstable_by(|a, b| {
         centroids[a.idx()][axis]
             .total_cmp(&centroids[b.idx()][axis])
             .then(a.cmp(b))
     });
+    // The weighted median, with at least one face on each side.
+    let mut acc = 0.0;
+    let mut mid = faces.len() - 1;
+    for (i, f) in faces.iter().enumerate() {
+        acc += weights[f.idx()];
+        if acc >= 0.5 * total {
+            mid = i + 1;
+            break;
+        }
+    }
+    let mid = mid.clamp(1, faces.len() - 1);
     let upper = faces.split_off(mid);
-    bisect(centroids, faces, max, out);
-    bisect(centroids, upper, max, out);
+    bisect(centroids, weights, faces, max, out);
+    bisect(centroids, weights, upper, max, out);
+}
+
+/// Each face's weight for [`partition`]: the faces an output on target makes of it (its area
+/// in the metric the patches are remeshed in, over the area of an equilateral triangle of
+/// side L_tar), at least [`MIN_FACE_WEIGHT`]. The region size then follows the metric and the
+/// target, not the input's resolution.
+pub fn face_weights(ctx: &RunContext<'_>, work: &WorkingMesh) -> Vec<f64> {
+    let field = ctx.field();
+    let metrics: Vec<nalgebra::Matrix3<f64>> = work
+        .locations
+        .par_iter()
+        .map(|l| field.eval_at(l))
+        .collect();
+    let ideal = 3f64.sqrt() / 4.0 * ctx.plan.l_tar * ctx.plan.l_tar;
+    work.mesh
+        .faces()
+        .map(|f| {
+            let t = work.mesh.face(f);
+            let m = t
+                .iter()
+                .map(|v| metrics[v.idx()])
+                .sum::<nalgebra::Matrix3<f64>>()
+                / 3.0;
+            let q = crate::quality::metric_sqrt(&m);
+            let [a, b, c] = work.mesh.face_points(f);
+            let area = 0.5 * (q * (b - a)).cross(&(q * (c - a))).norm();
+            (area / ideal).max(MIN_FACE_WEIGHT)
+        })
+        .collect()
 }
 
 /// One region's working mesh, cut out of the whole.
@@ -216,6 +264,16 @@ enum Level {
     Junctions = 2,
 }
 
+impl Level {
+    fn name(self) -> &'static str {
+        match self {
+            Level::Regions => "region",
+            Level::Strips => "strip",
+            Level::Junctions => "junction",
+        }
+    }
+}
+
 /// Split the whole run's working mesh into regions when it is larger than
 /// [`super::RemeshOptions::region_faces`] and remesh it in three levels of independent
 /// pieces, each level's at the same time: the regions, then the band around their cuts split
@@ -227,8 +285,17 @@ pub fn run_regions(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<usize,
     if o.max_patches.is_some() {
         return Ok(1);
     }
-    let parts = partition(&state.work.mesh, o.region_faces);
+    let weights = face_weights(ctx, &state.work);
+    let parts = partition(&state.work.mesh, &weights, o.region_faces as f64);
     if parts.len() < 2 {
+        return Ok(1);
+    }
+    // Cuts are frozen at the working mesh's resolution: where it is coarser than the output
+    // (the input's edges longer than the target in the metric), a region would keep edges the
+    // output cannot have along its cuts. Then the run keeps one region.
+    let cut = cut_edge_length(ctx, state, &parts, CUT_QUANTILE);
+    if cut > MAX_CUT_EDGE {
+        state.regions_declined = Some(cut);
         return Ok(1);
     }
     let clock = std::time::Instant::now();
@@ -279,6 +346,53 @@ fn mark_unprocessed(processed: &mut [bool], on: &[bool]) {
     for (p, o) in processed.iter_mut().zip(on) {
         *p &= !o;
     }
+}
+
+/// Regions are used only when at least [`CUT_QUANTILE`] of their cut edges are no longer than
+/// this many L_tar in the metric the patches are remeshed in.
+pub const MAX_CUT_EDGE: f64 = 1.2;
+
+/// See [`MAX_CUT_EDGE`].
+pub const CUT_QUANTILE: f64 = 0.9;
+
+/// The `quantile` of the lengths of the edges between two regions of `parts`, in the metric
+/// the patches are remeshed in, over L_tar.
+fn cut_edge_length(
+    ctx: &RunContext<'_>,
+    state: &LoopState,
+    parts: &[Vec<FaceId>],
+    quantile: f64,
+) -> f64 {
+    let mesh = &state.work.mesh;
+    let mut region_of = vec![0u32; mesh.n_faces()];
+    for (r, faces) in parts.iter().enumerate() {
+        faces.iter().for_each(|f| region_of[f.idx()] = r as u32);
+    }
+    let field = ctx.field();
+    let mut lengths: Vec<f64> = Vec::new();
+    for f in mesh.faces() {
+        for k in 0..3 {
+            let Some(g) = state.topo.neighbor(f, k) else {
+                continue;
+            };
+            if region_of[g.idx()] <= region_of[f.idx()] {
+                continue;
+            }
+            let t = mesh.triangles[f.idx()];
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let m = (field.eval_at(&state.work.locations[a.idx()])
+                + field.eval_at(&state.work.locations[b.idx()]))
+                / 2.0;
+            let d = mesh.position(b) - mesh.position(a);
+            lengths.push((d.transpose() * m * d)[0].max(0.0).sqrt() / ctx.plan.l_tar);
+        }
+    }
+    if lengths.is_empty() {
+        return 0.0;
+    }
+    lengths.sort_by(|a, b| a.total_cmp(b));
+    let i = ((quantile * lengths.len() as f64) as usize).min(lengths.len() - 1);
+    lengths[i]
 }
 
 /// Rings of faces around the junctions that the strips leave out, and that the junctions'
@@ -459,7 +573,18 @@ fn run_groups(
             let share = faces.len() as f64 / whole_faces;
             // Stream blocks: 2²⁰ regions per level at most.
             let index = ((level as usize) << 20) + r;
-            run_region(ctx, state, region, index, share, level == Level::Regions)
+            run_region(ctx, state, region, index, share, level == Level::Regions).map_err(|e| {
+                match e {
+                    // A stop request is the run's, not the piece's.
+                    PipelineError::Cancelled { .. } => e,
+                    e => PipelineError::Region {
+                        level: level.name(),
+                        index: r,
+                        faces: faces.len(),
+                        source: Box::new(e),
+                    },
+                }
+            })
         })
         .collect::<Result<_, _>>()?;
     Ok(merge(state, &region_of, runs))
@@ -662,7 +787,8 @@ mod tests {
     #[test]
     fn partition_covers_every_face_once_within_the_bound() {
         let mesh = generators::icosphere(1.0, 4);
-        let parts = partition(&mesh, 700);
+        let ones = vec![1.0; mesh.n_faces()];
+        let parts = partition(&mesh, &ones, 700.0);
         assert!(parts.len() >= mesh.n_faces() / 700);
         let mut seen = vec![0; mesh.n_faces()];
         for p in &parts {
@@ -675,9 +801,29 @@ mod tests {
             p.iter().for_each(|f| seen[f.idx()] += 1);
         }
         assert!(seen.iter().all(|n| *n == 1));
-        assert_eq!(parts, partition(&mesh, 700));
-        assert_eq!(partition(&mesh, 0).len(), 1);
-        assert_eq!(partition(&mesh, mesh.n_faces()).len(), 1);
+        assert_eq!(parts, partition(&mesh, &ones, 700.0));
+        assert_eq!(partition(&mesh, &ones, 0.0).len(), 1);
+        assert_eq!(partition(&mesh, &ones, mesh.n_faces() as f64).len(), 1);
+        // Weights move the cuts: a heavy half is cut into more regions than a light one.
+        let heavy: Vec<f64> = mesh
+            .faces()
+            .map(|f| match mesh.face_points(f)[0].x > 0.0 {
+                true => 4.0,
+                false => 1.0,
+            })
+            .collect();
+        let weighted = partition(&mesh, &heavy, 1400.0);
+        for p in &weighted {
+            let w: f64 = p.iter().map(|f| heavy[f.idx()]).sum();
+            assert!(w <= 1400.0 || p.len() == 1, "a region of weight {w}");
+        }
+        let on_heavy_side =
+            |p: &Vec<FaceId>| p.iter().filter(|f| heavy[f.idx()] > 1.0).count() * 2 > p.len();
+        let (h, l) = (
+            weighted.iter().filter(|p| on_heavy_side(p)).count(),
+            weighted.iter().filter(|p| !on_heavy_side(p)).count(),
+        );
+        assert!(h > l, "{h} regions on the heavy side, {l} on the light one");
     }
 
     /// A region that touches itself only at a vertex gets one vertex per fan there (a
@@ -747,7 +893,8 @@ mod tests {
             .collect();
         let sphere = generators::icosphere(1.0, 3);
         let mut thinned = vec![u32::MAX; sphere.n_faces()];
-        for (r, faces) in partition(&sphere, 200).iter().enumerate() {
+        let ones = vec![1.0; sphere.n_faces()];
+        for (r, faces) in partition(&sphere, &ones, 200.0).iter().enumerate() {
             for f in faces {
                 // Every third face of region 0 left out: pinches all over it.
                 if r != 0 || f.idx() % 3 != 0 {
