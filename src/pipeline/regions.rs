@@ -32,7 +32,7 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 /// The default of [`super::RemeshOptions::region_faces`]: the most output faces one region
-/// is expected to make ([`face_weights`]). Large enough that a region's patches are far from
+/// is expected to make (`face_weights`: the faces an output on target makes of each input face). Large enough that a region's patches are far from
 /// its cuts for most of its faces, small enough that a region's per-patch costs (stitching,
 /// certificates) stay bounded whatever the mesh's size.
 pub const DEFAULT_REGION_FACES: usize = 6_000;
@@ -46,7 +46,7 @@ const REGION_STREAMS: u64 = 1 << 32;
 /// regions' patches grade from the cut's input edges to the target size within about two.
 pub const BAND_RINGS: usize = 5;
 
-/// The least weight an input face counts for in [`partition`]'s bound ([`face_weights`]): a
+/// The least weight an input face counts for in [`partition`]'s bound (`face_weights`: the faces an output on target makes of each input face): a
 /// region holds at most 1/`MIN_FACE_WEIGHT` times the bound in input faces, however coarse
 /// the output there.
 pub const MIN_FACE_WEIGHT: f64 = 0.25;
