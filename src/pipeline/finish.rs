@@ -18,25 +18,7 @@ use std::time::Instant;
 /// feature-line piece where the run put it, and (exact) no self-intersections; then the mesh
 /// is compacted.
 pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(), PipelineError> {
-    let t0 = Instant::now();
-    state.topo = Topology::build(&state.work.mesh);
-    let pid = PatchId::new(state.patches);
-    let fail = |e: InvariantError| PipelineError::Certificate {
-        patch: pid,
-        seed: None,
-        violation: e,
-        debug_file: None,
-    };
-    let (mesh, topo) = (&state.work.mesh, &state.topo);
-    invariants::certify_manifold(mesh, topo).map_err(fail)?;
-    invariants::certify_oriented(mesh, topo).map_err(fail)?;
-    ctx.signature
-        .certify_same(&TopologySignature::of(topo))
-        .map_err(fail)?;
-    certify_boundary(ctx, state).map_err(fail)?;
-    certify_corners(ctx, state)?;
-    certify_features(state)?;
-    state.counters.times.certify += t0.elapsed().as_secs_f64();
+    certify_whole(ctx, state)?;
     let map = state.work.compact();
     let mut bound = vec![1.0; state.work.mesh.n_vertices()];
     for (old, new) in map.iter().enumerate() {
@@ -64,6 +46,32 @@ pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(),
         }
     }
     state.counters.times.final_check = t0.elapsed().as_secs_f64();
+    Ok(())
+}
+
+/// The working mesh once more, whole (its topology built again): an oriented manifold with
+/// the run's topology, its boundary ([`certify_boundary`]), every corner and feature-line piece
+/// where the run put it. The run's end, and each region's ([`super::regions`]).
+pub fn certify_whole(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(), PipelineError> {
+    let t0 = Instant::now();
+    state.topo = Topology::build(&state.work.mesh);
+    let pid = PatchId::new(state.patches);
+    let fail = |e: InvariantError| PipelineError::Certificate {
+        patch: pid,
+        seed: None,
+        violation: e,
+        debug_file: None,
+    };
+    let (mesh, topo) = (&state.work.mesh, &state.topo);
+    invariants::certify_manifold(mesh, topo).map_err(fail)?;
+    invariants::certify_oriented(mesh, topo).map_err(fail)?;
+    ctx.signature
+        .certify_same(&TopologySignature::of(topo))
+        .map_err(fail)?;
+    certify_boundary(ctx, state).map_err(fail)?;
+    certify_corners(ctx, state)?;
+    certify_features(state)?;
+    state.counters.times.certify += t0.elapsed().as_secs_f64();
     Ok(())
 }
 

@@ -23,7 +23,7 @@ use super::context::{FrozenCut, LoopState, RunContext};
 use super::error::PipelineError;
 use crate::features::FeatureLines;
 use crate::ids::{EdgeKey, FaceId, PatchId, VertexId};
-use crate::invariants::{self, InvariantError, TopologySignature};
+use crate::invariants::{self, TopologySignature};
 use crate::mesh::{Topology, TriMesh, UnionFind};
 use crate::stitch::WorkingMesh;
 use nalgebra::Point3;
@@ -642,7 +642,9 @@ fn run_region(
     rng.set_stream(state.streams);
     super::patch_loop(&rctx, &mut state, &mut rng, &mut |_| {})?;
     super::improvement::run(&rctx, &mut state, &mut rng)?;
-    certify_region(&rctx, &mut state)?;
+    // The piece whole: manifold, oriented, its topology, its cuts kept and its other
+    // boundary on the input's curves, corners and feature lines where they were.
+    super::finish::certify_whole(&rctx, &mut state)?;
     Ok(RegionRun { region, state })
 }
 
@@ -672,31 +674,6 @@ fn region_features(whole: &FeatureLines, region: &RegionMesh) -> FeatureLines {
         }
     }
     out
-}
-
-/// A region's certificates after its loop and improvers: an oriented manifold with the
-/// region's topology, its boundary kept ([`certify_region_boundary`]), its corners and
-/// feature lines where they were.
-fn certify_region(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(), PipelineError> {
-    let t0 = std::time::Instant::now();
-    state.topo = Topology::build(&state.work.mesh);
-    let fail = |e: InvariantError| PipelineError::Certificate {
-        patch: PatchId::new(state.patches),
-        seed: None,
-        violation: e,
-        debug_file: None,
-    };
-    let (mesh, topo) = (&state.work.mesh, &state.topo);
-    invariants::certify_manifold(mesh, topo).map_err(fail)?;
-    invariants::certify_oriented(mesh, topo).map_err(fail)?;
-    ctx.signature
-        .certify_same(&TopologySignature::of(topo))
-        .map_err(fail)?;
-    super::replace::certify_boundary(ctx, state).map_err(fail)?;
-    super::finish::certify_corners(ctx, state)?;
-    super::finish::certify_features(state)?;
-    state.counters.times.certify += t0.elapsed().as_secs_f64();
-    Ok(())
 }
 
 /// Put the regions' meshes back into the whole: the whole mesh's vertices keep their ids
