@@ -396,9 +396,8 @@ fn cut_edge_length(
 }
 
 /// Rings of faces around the junctions that the strips leave out, and that the junctions'
-/// pieces remesh with [`BAND_RINGS`] more (the strips' ends): more than twice the band's
-/// width, so that the strips along two cuts that meet do not touch outside the disc.
-pub const JUNCTION_RINGS: usize = 12;
+/// pieces remesh with [`BAND_RINGS`] more (the strips' ends).
+pub const JUNCTION_RINGS: usize = 8;
 
 /// `flags[v]` for the vertices within `rings` rings of `seeds`.
 fn vertices_near(mesh: &TriMesh, seeds: &[VertexId], rings: usize) -> Vec<bool> {
