@@ -32,9 +32,10 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 /// The default of [`super::RemeshOptions::region_faces`]: the most output faces one region
-/// is expected to make (`face_weights`: the faces an output on target makes of each input face). Large enough that a region's patches are far from
-/// its cuts for most of its faces, small enough that a region's per-patch costs (stitching,
-/// certificates) stay bounded whatever the mesh's size.
+/// is expected to make (each input face weighing the faces an output on target makes of it).
+/// Large enough that a region's patches are far from its cuts for most of its faces, small
+/// enough that a region's per-patch costs (stitching, certificates) stay bounded whatever the
+/// mesh's size.
 pub const DEFAULT_REGION_FACES: usize = 6_000;
 
 /// Streams per region: region r's loop draws ChaCha8 stream `(r + 1) · REGION_STREAMS`, and
@@ -42,13 +43,13 @@ pub const DEFAULT_REGION_FACES: usize = 6_000;
 /// run's (`s + 1`) and from every other region's.
 const REGION_STREAMS: u64 = 1 << 32;
 
-/// Rings of faces around every cut that Algorithm 1 remeshes again after the merge: the
-/// regions' patches grade from the cut's input edges to the target size within about two.
+/// Rings of faces around every cut that the strips and junctions remesh after the regions:
+/// the regions' patches grade from the cut's input edges to the target size near it.
 pub const BAND_RINGS: usize = 5;
 
-/// The least weight an input face counts for in [`partition`]'s bound (`face_weights`: the faces an output on target makes of each input face): a
-/// region holds at most 1/`MIN_FACE_WEIGHT` times the bound in input faces, however coarse
-/// the output there.
+/// The least weight an input face counts for in the regions' bound (each face weighs the
+/// faces an output on target makes of it): a region holds at most 1/`MIN_FACE_WEIGHT` times
+/// the bound in input faces, however coarse the output there.
 pub const MIN_FACE_WEIGHT: f64 = 0.25;
 
 /// The faces of `mesh` split into regions of weight at most `max_weight` by recursive
@@ -124,13 +125,11 @@ fn bisect(
 /// in the metric the patches are remeshed in, over the area of an equilateral triangle of
 /// side L_tar), at least [`MIN_FACE_WEIGHT`]. The region size then follows the metric and the
 /// target, not the input's resolution.
-pub fn face_weights(ctx: &RunContext<'_>, work: &WorkingMesh) -> Vec<f64> {
-    let field = ctx.field();
-    let metrics: Vec<nalgebra::Matrix3<f64>> = work
-        .locations
-        .par_iter()
-        .map(|l| field.eval_at(l))
-        .collect();
+fn face_weights(
+    ctx: &RunContext<'_>,
+    work: &WorkingMesh,
+    metrics: &[nalgebra::Matrix3<f64>],
+) -> Vec<f64> {
     let ideal = 3f64.sqrt() / 4.0 * ctx.plan.l_tar * ctx.plan.l_tar;
     work.mesh
         .faces()
@@ -141,10 +140,7 @@ pub fn face_weights(ctx: &RunContext<'_>, work: &WorkingMesh) -> Vec<f64> {
                 .map(|v| metrics[v.idx()])
                 .sum::<nalgebra::Matrix3<f64>>()
                 / 3.0;
-            let q = crate::quality::metric_sqrt(&m);
-            let [a, b, c] = work.mesh.face_points(f);
-            let area = 0.5 * (q * (b - a)).cross(&(q * (c - a))).norm();
-            (area / ideal).max(MIN_FACE_WEIGHT)
+            (super::sizing::metric_area(work.mesh.face_points(f), &m) / ideal).max(MIN_FACE_WEIGHT)
         })
         .collect()
 }
@@ -248,7 +244,7 @@ pub fn extract(
 }
 
 /// What a region's run leaves for the merge.
-pub struct RegionRun {
+struct RegionRun {
     region: RegionMesh,
     state: LoopState,
 }
@@ -274,8 +270,8 @@ impl Level {
     }
 }
 
-/// Split the whole run's working mesh into regions when it is larger than
-/// [`super::RemeshOptions::region_faces`] and remesh it in three levels of independent
+/// Split the whole run's working mesh into regions when it is expected to make more than
+/// [`super::RemeshOptions::region_faces`] output faces and remesh it in three levels of independent
 /// pieces, each level's at the same time: the regions, then the band around their cuts split
 /// at the junctions into strips, then the junctions. Returns the number of regions (1:
 /// nothing was done, the loop runs on the whole mesh as in the paper).
@@ -285,7 +281,12 @@ pub fn run_regions(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<usize,
     if o.max_patches.is_some() {
         return Ok(1);
     }
-    let weights = face_weights(ctx, &state.work);
+    // The metric the patches are remeshed in, at every vertex (the weights and the cuts').
+    let field = ctx.field();
+    let metrics: Vec<nalgebra::Matrix3<f64>> = (state.work.locations.par_iter())
+        .map(|l| field.eval_at(l))
+        .collect();
+    let weights = face_weights(ctx, &state.work, &metrics);
     let parts = partition(&state.work.mesh, &weights, o.region_faces as f64);
     if parts.len() < 2 {
         return Ok(1);
@@ -293,7 +294,7 @@ pub fn run_regions(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<usize,
     // Cuts are frozen at the working mesh's resolution: where it is coarser than the output
     // (the input's edges longer than the target in the metric), a region would keep edges the
     // output cannot have along its cuts. Then the run keeps one region.
-    let cut = cut_edge_length(ctx, state, &parts, CUT_QUANTILE);
+    let cut = cut_edge_length(ctx, state, &metrics, &parts, CUT_QUANTILE);
     if cut > MAX_CUT_EDGE {
         state.regions_declined = Some(cut);
         return Ok(1);
@@ -360,6 +361,7 @@ pub const CUT_QUANTILE: f64 = 0.9;
 fn cut_edge_length(
     ctx: &RunContext<'_>,
     state: &LoopState,
+    metrics: &[nalgebra::Matrix3<f64>],
     parts: &[Vec<FaceId>],
     quantile: f64,
 ) -> f64 {
@@ -368,7 +370,6 @@ fn cut_edge_length(
     for (r, faces) in parts.iter().enumerate() {
         faces.iter().for_each(|f| region_of[f.idx()] = r as u32);
     }
-    let field = ctx.field();
     let mut lengths: Vec<f64> = Vec::new();
     for f in mesh.faces() {
         for k in 0..3 {
@@ -380,9 +381,7 @@ fn cut_edge_length(
             }
             let t = mesh.triangles[f.idx()];
             let (a, b) = (t[k], t[(k + 1) % 3]);
-            let m = (field.eval_at(&state.work.locations[a.idx()])
-                + field.eval_at(&state.work.locations[b.idx()]))
-                / 2.0;
+            let m = (metrics[a.idx()] + metrics[b.idx()]) / 2.0;
             let d = mesh.position(b) - mesh.position(a);
             lengths.push((d.transpose() * m * d)[0].max(0.0).sqrt() / ctx.plan.l_tar);
         }

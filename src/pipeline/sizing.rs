@@ -256,12 +256,16 @@ pub fn expected_faces(
                 .map(|v| metrics[v.idx()] * s(*v))
                 .sum::<Matrix3<f64>>()
                 / 3.0;
-            let q = crate::quality::metric_sqrt(&m);
-            let [a, b, c] = reference.face_points(f);
-            0.5 * (q * (b - a)).cross(&(q * (c - a))).norm()
+            metric_area(reference.face_points(f), &m)
         })
         .sum();
     area / (3f64.sqrt() / 4.0 * l_tar * l_tar)
+}
+
+/// The area of the triangle `[a, b, c]` in the constant metric `m`.
+pub fn metric_area([a, b, c]: [nalgebra::Point3<f64>; 3], m: &Matrix3<f64>) -> f64 {
+    let q = crate::quality::metric_sqrt(m);
+    0.5 * (q * (b - a)).cross(&(q * (c - a))).norm()
 }
 
 /// The expected output face counts of a run with `options` ([`expected_faces`] at its L_tar,
