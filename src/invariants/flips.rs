@@ -4,6 +4,7 @@ use crate::ids::FaceId;
 use crate::mesh::{SurfaceProjector, TriMesh};
 use nalgebra::{Point3, Vector3};
 use parry3d_f64::math::Vector as PVec;
+use std::sync::Arc;
 
 /// The flip test of the quality issue: a face is flipped when its normal points more than 90°
 /// away from the normal of the input face closest to its centroid.
@@ -20,23 +21,47 @@ use parry3d_f64::math::Vector as PVec;
 /// strictly negative = flipped: a float decision on normals, not an exact predicate. Zero-area
 /// faces (zero normal) are never reported here (the degenerate-face certificate catches them).
 pub struct FlipTest {
-    proj: SurfaceProjector,
-    input: TriMesh,
-    vertex_faces: Vec<Vec<FaceId>>,
+    proj: Arc<SurfaceProjector>,
+    input: Arc<TriMesh>,
+    /// The faces around each input vertex: those of `v` are
+    /// `vertex_faces[vertex_start[v]..vertex_start[v + 1]]` (one allocation, not one per vertex).
+    vertex_start: Vec<u32>,
+    vertex_faces: Vec<FaceId>,
 }
 
 impl FlipTest {
     /// Index the input surface.
     pub fn new(input: &TriMesh) -> FlipTest {
-        let mut vertex_faces = vec![Vec::new(); input.n_vertices()];
+        FlipTest::with_index(
+            Arc::new(input.clone()),
+            Arc::new(SurfaceProjector::new(input)),
+        )
+    }
+
+    /// The test against `input`, sharing it and its closest-point index `proj` (a metric
+    /// field's, say) instead of copying them.
+    pub fn with_index(input: Arc<TriMesh>, proj: Arc<SurfaceProjector>) -> FlipTest {
+        let mut vertex_start = vec![0u32; input.n_vertices() + 1];
+        for t in &input.triangles {
+            for v in t {
+                vertex_start[v.idx() + 1] += 1;
+            }
+        }
+        for v in 0..input.n_vertices() {
+            vertex_start[v + 1] += vertex_start[v];
+        }
+        let mut next = vertex_start.clone();
+        let mut vertex_faces = vec![FaceId(0); 3 * input.n_faces()];
         for (f, t) in input.triangles.iter().enumerate() {
             for v in t {
-                vertex_faces[v.idx()].push(FaceId::new(f));
+                vertex_faces[next[v.idx()] as usize] = FaceId::new(f);
+                next[v.idx()] += 1;
             }
         }
         FlipTest {
-            proj: SurfaceProjector::new(input),
-            input: input.clone(),
+            proj,
+            input,
+            vertex_start,
             vertex_faces,
         }
     }
@@ -65,7 +90,9 @@ impl FlipTest {
         // vertex of it).
         let tol = d * 1e-9 + f64::MIN_POSITIVE;
         for v in self.input.face(fin) {
-            for &g in &self.vertex_faces[v.idx()] {
+            let around =
+                self.vertex_start[v.idx()] as usize..self.vertex_start[v.idx() + 1] as usize;
+            for &g in &self.vertex_faces[around] {
                 if g == fin {
                     continue;
                 }

@@ -24,6 +24,20 @@ impl SurfaceProjector {
         }
     }
 
+    /// Index the triangles of `mesh`, which must have some; parry's refusal as text.
+    pub fn try_new(mesh: &TriMesh) -> Result<Self, String> {
+        let vertices: Vec<PVec> = (mesh.positions.iter())
+            .map(|p| PVec::new(p.x, p.y, p.z))
+            .collect();
+        let bvh = PTriMesh::new(vertices, mesh.index_triangles()).map_err(|e| e.to_string())?;
+        Ok(SurfaceProjector { bvh: Some(bvh) })
+    }
+
+    /// parry's triangle mesh and BVH (`None` for a mesh without faces).
+    pub fn parry(&self) -> Option<&PTriMesh> {
+        self.bvh.as_ref()
+    }
+
     /// The closest point of the surface to `p`, the face it lies on, and the distance.
     /// `None` for an empty surface or a non-finite `p`.
     pub fn closest(&self, p: &Point3<f64>) -> Option<(FaceId, Point3<f64>, f64)> {

@@ -5,11 +5,11 @@
 
 use super::{curvature_metric, MetricError, MetricOptions};
 use crate::ids::FaceId;
-use crate::mesh::{SurfaceLocation, TriMesh};
+use crate::mesh::{SurfaceLocation, SurfaceProjector, TriMesh};
 use nalgebra::{Matrix2, Matrix3, Point3, Vector3};
 use parry3d_f64::math::Vector as PVector;
 use parry3d_f64::query::PointQueryWithLocation;
-use parry3d_f64::shape::TriMesh as ParryTriMesh;
+use std::sync::Arc;
 
 /// Relative tolerance of the symmetry and positive-semi-definiteness checks of
 /// [`MetricField::new`] (relative to the largest absolute entry / eigenvalue).
@@ -21,12 +21,15 @@ pub const TANGENT_PD_RELATIVE_TOLERANCE: f64 = 1e-12;
 
 /// A Riemannian metric field on a reference surface: per-vertex symmetric tensors plus a BVH
 /// (parry3d-f64) for closest-point queries. `Send + Sync`; cheap queries from many threads.
+/// The reference, its face normals and the BVH are shared (`Arc`) by every field made from
+/// this one with [`MetricField::with_metrics`]: on a surface of a million faces each copy of
+/// them costs a few hundred MB.
 #[derive(Clone)]
 pub struct MetricField {
-    reference: TriMesh,
+    reference: Arc<TriMesh>,
     metrics: Vec<Matrix3<f64>>,
-    face_normals: Vec<Vector3<f64>>,
-    bvh: ParryTriMesh,
+    face_normals: Arc<Vec<Vector3<f64>>>,
+    projector: Arc<SurfaceProjector>,
 }
 
 impl std::fmt::Debug for MetricField {
@@ -36,6 +39,28 @@ impl std::fmt::Debug for MetricField {
             .field("faces", &self.reference.n_faces())
             .finish_non_exhaustive()
     }
+}
+
+/// `vertex_metrics` checked against `reference` (one tensor per vertex, each valid for its
+/// vertex normal) and symmetrised.
+fn checked_metrics(
+    reference: &TriMesh,
+    vertex_metrics: Vec<Matrix3<f64>>,
+) -> Result<Vec<Matrix3<f64>>, MetricError> {
+    if vertex_metrics.len() != reference.n_vertices() {
+        return Err(MetricError::CountMismatch {
+            expected: reference.n_vertices(),
+            found: vertex_metrics.len(),
+        });
+    }
+    let normals = reference.vertex_normals();
+    for (v, (m, n)) in vertex_metrics.iter().zip(&normals).enumerate() {
+        validate_vertex_metric(v, m, n)?;
+    }
+    Ok(vertex_metrics
+        .into_iter()
+        .map(|m| (m + m.transpose()) * 0.5)
+        .collect())
 }
 
 /// Check one vertex tensor (see [`MetricField::new`]); `normal` may be zero (check skipped).
@@ -151,37 +176,38 @@ impl MetricField {
     /// skip the tangent check. The stored tensors are the symmetric parts of the inputs.
     pub fn new(reference: TriMesh, vertex_metrics: Vec<Matrix3<f64>>) -> Result<Self, MetricError> {
         reference.validate()?;
-        if vertex_metrics.len() != reference.n_vertices() {
-            return Err(MetricError::CountMismatch {
-                expected: reference.n_vertices(),
-                found: vertex_metrics.len(),
-            });
-        }
-        let normals = reference.vertex_normals();
-        for (v, (m, n)) in vertex_metrics.iter().zip(&normals).enumerate() {
-            validate_vertex_metric(v, m, n)?;
-        }
-        let metrics = vertex_metrics
-            .into_iter()
-            .map(|m| (m + m.transpose()) * 0.5)
-            .collect();
-        let bvh = ParryTriMesh::new(
-            reference.positions.iter().map(to_parry).collect(),
-            reference.index_triangles(),
-        )
-        .map_err(|e| MetricError::Bvh {
-            detail: e.to_string(),
-        })?;
+        let metrics = checked_metrics(&reference, vertex_metrics)?;
+        let projector =
+            SurfaceProjector::try_new(&reference).map_err(|detail| MetricError::Bvh { detail })?;
         let face_normals = reference
             .faces()
             .map(|f| reference.face_normal(f))
             .collect();
         Ok(MetricField {
-            reference,
+            reference: Arc::new(reference),
             metrics,
-            face_normals,
-            bvh,
+            face_normals: Arc::new(face_normals),
+            projector: Arc::new(projector),
         })
+    }
+
+    /// Other tensors on the same reference (validated as [`MetricField::new`]), sharing its
+    /// mesh, normals and BVH.
+    pub fn with_metrics(&self, vertex_metrics: Vec<Matrix3<f64>>) -> Result<Self, MetricError> {
+        Ok(MetricField {
+            metrics: checked_metrics(&self.reference, vertex_metrics)?,
+            ..self.clone_shared()
+        })
+    }
+
+    /// This field's shared parts with no tensors; filled in by the caller.
+    fn clone_shared(&self) -> Self {
+        MetricField {
+            reference: Arc::clone(&self.reference),
+            metrics: Vec::new(),
+            face_normals: Arc::clone(&self.face_normals),
+            projector: Arc::clone(&self.projector),
+        }
     }
 
     /// A field from a user's tensors (validated as [`MetricField::new`]), restricted to the
@@ -226,6 +252,16 @@ impl MetricField {
         &self.reference
     }
 
+    /// The reference surface, shared.
+    pub fn shared_reference(&self) -> &Arc<TriMesh> {
+        &self.reference
+    }
+
+    /// The closest-point index of the reference surface, shared.
+    pub fn projector(&self) -> &Arc<SurfaceProjector> {
+        &self.projector
+    }
+
     /// The tensor of every reference vertex, in vertex order.
     pub fn vertex_metrics(&self) -> &[Matrix3<f64>] {
         &self.metrics
@@ -235,9 +271,11 @@ impl MetricField {
     /// via parry's BVH), as a location (face + barycentric coordinates clamped to the face,
     /// summing to 1) and its position. A non-finite `p` yields a corner of face `f0`.
     pub fn project(&self, p: &Point3<f64>) -> (SurfaceLocation, Point3<f64>) {
-        let (proj, (tri, _)) = self
-            .bvh
-            .project_local_point_and_get_location(to_parry(p), false);
+        let bvh = self
+            .projector
+            .parry()
+            .expect("a field's reference has faces");
+        let (proj, (tri, _)) = bvh.project_local_point_and_get_location(to_parry(p), false);
         let face = if (tri as usize) < self.reference.n_faces() {
             FaceId(tri)
         } else {
@@ -253,8 +291,11 @@ impl MetricField {
     /// BVH), ascending. Used to find the part of the reference surface under a patch.
     pub fn faces_in_box(&self, lo: &Point3<f64>, hi: &Point3<f64>) -> Vec<FaceId> {
         let aabb = parry3d_f64::bounding_volume::Aabb::new(to_parry(lo), to_parry(hi));
-        let mut faces: Vec<FaceId> = self
-            .bvh
+        let bvh = self
+            .projector
+            .parry()
+            .expect("a field's reference has faces");
+        let mut faces: Vec<FaceId> = bvh
             .bvh()
             .intersect_aabb(&aabb)
             .filter(|&f| (f as usize) < self.reference.n_faces())
@@ -311,5 +352,29 @@ mod tests {
             barycentric(&Point3::new(0.9, 0.0, 0.0), degenerate),
             [0.0, 1.0, 0.0]
         );
+    }
+
+    #[test]
+    fn fields_with_other_metrics_share_the_reference_and_its_index() {
+        let sphere = crate::mesh::generators::icosphere(1.0, 2);
+        let n = sphere.n_vertices();
+        let field = MetricField::new(sphere, vec![Matrix3::identity(); n]).expect("identity");
+        let scaled = field
+            .with_metrics(vec![Matrix3::identity() * 4.0; n])
+            .expect("scaled identity");
+        assert!(Arc::ptr_eq(field.projector(), scaled.projector()));
+        assert!(Arc::ptr_eq(field.shared_reference(), scaled.shared_reference()));
+        assert_eq!(scaled.vertex_metrics()[0], Matrix3::identity() * 4.0);
+        assert_eq!(field.vertex_metrics()[0], Matrix3::identity());
+        let p = Point3::new(0.3, 0.2, 2.0);
+        assert_eq!(field.project(&p).1, scaled.project(&p).1);
+        // The same checks as a new field: the count, and SPD on the tangent plane.
+        assert!(matches!(
+            field.with_metrics(vec![Matrix3::identity(); n - 1]),
+            Err(MetricError::CountMismatch { .. })
+        ));
+        let mut bad = vec![Matrix3::identity(); n];
+        bad[3] = -Matrix3::identity();
+        assert!(field.with_metrics(bad).is_err());
     }
 }

@@ -115,7 +115,10 @@ impl<'a> RunContext<'a> {
             plan,
             stages: stages.loop_stages(),
             improvers: &stages.improvers,
-            flip_test: Arc::new(FlipTest::new(reference)),
+            flip_test: Arc::new(FlipTest::with_index(
+                Arc::clone(field.shared_reference()),
+                Arc::clone(field.projector()),
+            )),
             ref_normals: Arc::new(reference.area_weighted_normals()),
             input_pairs,
             embedded_input: o.check_self_intersections && input_pairs == 0,

@@ -96,7 +96,7 @@ impl Plan {
                         1.0,
                         &options.sizes,
                     );
-                    Some(MetricField::new(reference.clone(), m).map_err(|e| {
+                    Some(field.with_metrics(m).map_err(|e| {
                         PipelineError::Input(format!("size-controlled metric: {e}"))
                     })?)
                 }
@@ -158,7 +158,8 @@ impl Plan {
                 .map(|(m, f)| m * *f)
                 .collect();
             Some(
-                MetricField::new(reference.clone(), metrics)
+                field
+                    .with_metrics(metrics)
                     .map_err(|e| PipelineError::Input(format!("fidelity-scaled metric: {e}")))?,
             )
         };
