@@ -321,6 +321,25 @@ pub fn run(args: RemeshArgs) -> anyhow::Result<ExitCode> {
             i.seconds
         );
     }
+    let s = &r.small_angles;
+    if !s.faces.is_empty() {
+        let kept: Vec<String> = (s.faces.iter().filter(|f| f.all_corners))
+            .map(|f| f.face.to_string())
+            .collect();
+        println!(
+            "faces below {}° in the metric: {} (at a kept corner {}, a feature line {}, the boundary {}, inside {}){}",
+            s.threshold_deg,
+            s.faces.len(),
+            s.corner,
+            s.feature,
+            s.boundary,
+            s.interior,
+            match kept.is_empty() {
+                true => String::new(),
+                false => format!("; between three kept corners: {}", kept.join(", ")),
+            }
+        );
+    }
     if r.coarse_input {
         println!(
             "coarse-input profile ran ({} sweeps, fidelity floor {} of the mean input edge, {} rounds, persistent factors)",

@@ -363,7 +363,10 @@ mod tests {
             .with_metrics(vec![Matrix3::identity() * 4.0; n])
             .expect("scaled identity");
         assert!(Arc::ptr_eq(field.projector(), scaled.projector()));
-        assert!(Arc::ptr_eq(field.shared_reference(), scaled.shared_reference()));
+        assert!(Arc::ptr_eq(
+            field.shared_reference(),
+            scaled.shared_reference()
+        ));
         assert_eq!(scaled.vertex_metrics()[0], Matrix3::identity() * 4.0);
         assert_eq!(field.vertex_metrics()[0], Matrix3::identity());
         let p = Point3::new(0.3, 0.2, 2.0);

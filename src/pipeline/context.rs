@@ -251,6 +251,9 @@ pub struct LoopState {
     /// (when the input is embedded); built again before each pass of patches
     /// ([`LoopState::index_faces`]).
     pub near: Option<crate::invariants::NearFaces>,
+    /// What holds each vertex of the compacted output in place (set by
+    /// [`super::finish::certify_output`]; empty before).
+    pub vertex_kinds: Vec<super::records::VertexKind>,
 }
 
 /// Per-stage times and certificate counts of a run.
@@ -360,6 +363,7 @@ impl LoopState {
             regions: None,
             regions_declined: None,
             near: None,
+            vertex_kinds: Vec::new(),
             work,
             topo,
             features,

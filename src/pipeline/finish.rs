@@ -4,7 +4,8 @@
 use super::context::{LoopState, RunContext};
 use super::error::PipelineError;
 use super::records::{
-    FaceSummary, RegionsReport, RemeshReport, RemeshResult, SeamQuality, Sizes, Warning,
+    FaceSummary, RegionsReport, RemeshReport, RemeshResult, SeamQuality, Sizes, SmallAngles,
+    VertexKind, Warning,
 };
 use super::replace::certify_boundary;
 use crate::ids::{EdgeKey, PatchId, VertexId};
@@ -19,11 +20,14 @@ use std::time::Instant;
 /// is compacted.
 pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(), PipelineError> {
     certify_whole(ctx, state)?;
+    let kinds = vertex_kinds(ctx, state);
     let map = state.work.compact();
     let mut bound = vec![1.0; state.work.mesh.n_vertices()];
+    state.vertex_kinds = vec![VertexKind::Interior; state.work.mesh.n_vertices()];
     for (old, new) in map.iter().enumerate() {
         if let Some(n) = new {
             bound[n.idx()] = state.bound.get(old).copied().unwrap_or(1.0);
+            state.vertex_kinds[n.idx()] = kinds[old];
         }
     }
     state.bound = bound;
@@ -47,6 +51,28 @@ pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(),
     }
     state.counters.times.final_check = t0.elapsed().as_secs_f64();
     Ok(())
+}
+
+/// What holds each working-mesh vertex in place: kept corners (cone points by their input
+/// ids, which the working mesh keeps until [`crate::stitch::WorkingMesh::compact`]; boundary
+/// corners by their curve point), feature-line vertices, boundary vertices.
+fn vertex_kinds(ctx: &RunContext<'_>, state: &LoopState) -> Vec<VertexKind> {
+    (0..state.work.mesh.n_vertices())
+        .map(|v| {
+            let id = VertexId::new(v);
+            let curve = state.work.curve.get(v).copied().flatten();
+            let curve_corner = curve.is_some_and(|p| ctx.curves.is_corner_point(&p));
+            if ctx.corners.get(v).copied().unwrap_or(false) || curve_corner {
+                VertexKind::Corner
+            } else if state.features.is_pinned(id) {
+                VertexKind::Feature
+            } else if curve.is_some() || state.topo.is_boundary_vertex(id) {
+                VertexKind::Boundary
+            } else {
+                VertexKind::Interior
+            }
+        })
+        .collect()
 }
 
 /// The working mesh once more, whole (its topology built again): an oriented manifold with
@@ -274,7 +300,9 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
         &state.work.mesh,
         &out_topo,
     );
+    let small_angles = SmallAngles::of(&state.work.mesh, &metrics, &state.vertex_kinds);
     let report = RemeshReport {
+        small_angles,
         improvement: state.improvement,
         seams,
         regions,

@@ -53,8 +53,8 @@ pub use options::{
 };
 pub use records::{
     AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,
-    PatchRecord, PhaseTimes, Progress, RegionsReport, RemeshReport, RemeshResult, StageTimes,
-    Warning,
+    PatchRecord, PhaseTimes, Progress, RegionsReport, RemeshReport, RemeshResult, SmallAngleFace,
+    SmallAngles, StageTimes, VertexKind, Warning, SMALL_ANGLE_DEG,
 };
 pub use regions::{
     partition, BAND_RINGS, CUT_QUANTILE, DEFAULT_REGION_FACES, MAX_CUT_EDGE, MIN_FACE_WEIGHT,

@@ -466,6 +466,97 @@ pub struct RegionsReport {
     pub declined_cut_edge: Option<f64>,
 }
 
+/// The smallest angle, in degrees and in the metric, below which a face is reported (the
+/// paper's Fig. 6 marks these faces).
+pub const SMALL_ANGLE_DEG: f64 = 20.0;
+
+/// What holds a vertex of the output in place, from the most held to the least.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VertexKind {
+    /// A kept input corner (`--corner-defect`, or a boundary corner): never moved.
+    Corner,
+    /// On a feature line: moved along it only by resampling, never by the improvers.
+    Feature,
+    /// On the boundary: on the input's boundary curve.
+    Boundary,
+    /// Free.
+    #[default]
+    Interior,
+}
+
+/// A face below [`SMALL_ANGLE_DEG`] and why it may be there: the most held kind among its
+/// vertices (a face with a kept corner is the corner's, then a feature line's, then the
+/// boundary's).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SmallAngleFace {
+    /// The face in the output mesh.
+    pub face: crate::ids::FaceId,
+    /// Its smallest angle in the metric, in degrees.
+    pub angle_deg: f64,
+    /// The most held kind among its three vertices.
+    pub cause: VertexKind,
+    /// All three of its vertices are kept input corners: no pass may change it.
+    pub all_corners: bool,
+}
+
+/// The faces below [`SMALL_ANGLE_DEG`] in the metric, smallest angle first, and how many
+/// there are of each cause.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SmallAngles {
+    /// The threshold, in degrees.
+    pub threshold_deg: f64,
+    /// Each such face.
+    pub faces: Vec<SmallAngleFace>,
+    /// Faces with a kept corner.
+    pub corner: usize,
+    /// Faces with a feature-line vertex (and no corner).
+    pub feature: usize,
+    /// Faces with a boundary vertex (and no corner or feature-line vertex).
+    pub boundary: usize,
+    /// The other faces.
+    pub interior: usize,
+}
+
+impl SmallAngles {
+    /// The faces of `mesh` below [`SMALL_ANGLE_DEG`] under `vertex_metrics`, each with the
+    /// most held kind of its vertices (`kinds`, per vertex).
+    pub fn of(
+        mesh: &crate::mesh::TriMesh,
+        vertex_metrics: &[nalgebra::Matrix3<f64>],
+        kinds: &[VertexKind],
+    ) -> SmallAngles {
+        let qs = crate::quality::face_qualities(mesh, vertex_metrics);
+        let kind = |v: crate::ids::VertexId| kinds.get(v.idx()).copied().unwrap_or_default();
+        let mut faces: Vec<SmallAngleFace> = (mesh.faces().zip(&qs))
+            .filter(|(_, q)| q.min_angle() < SMALL_ANGLE_DEG)
+            .map(|(f, q)| {
+                let t = mesh.face(f);
+                SmallAngleFace {
+                    face: f,
+                    angle_deg: q.min_angle(),
+                    cause: t.iter().map(|&v| kind(v)).min().unwrap_or_default(),
+                    all_corners: t.iter().all(|&v| kind(v) == VertexKind::Corner),
+                }
+            })
+            .collect();
+        faces.sort_by(|a, b| {
+            a.angle_deg
+                .total_cmp(&b.angle_deg)
+                .then(a.face.cmp(&b.face))
+        });
+        let count = |k: VertexKind| faces.iter().filter(|f| f.cause == k).count();
+        SmallAngles {
+            threshold_deg: SMALL_ANGLE_DEG,
+            corner: count(VertexKind::Corner),
+            feature: count(VertexKind::Feature),
+            boundary: count(VertexKind::Boundary),
+            interior: count(VertexKind::Interior),
+            faces,
+        }
+    }
+}
+
 /// The faces touching a patch seam against the rest (see [`RemeshReport::seams`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct SeamQuality {
@@ -497,6 +588,8 @@ pub struct Sizes {
 pub struct RemeshReport {
     /// Options used (after the coarse-input profile, when it ran).
     pub options: RemeshOptions,
+    /// The faces below 20° in the metric, each with its cause.
+    pub small_angles: SmallAngles,
     /// The improvers after the loop (Sec. 3.4), when any ran.
     pub improvement: Option<ImprovementReport>,
     /// Strategy / parameterizer / remesher names.
