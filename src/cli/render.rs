@@ -11,7 +11,7 @@ use std::process::ExitCode;
 /// `--wireframe`.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WireArg {
-    /// When the visible triangles are large enough on screen (40 pixels each on average).
+    /// When the visible triangles are large enough on screen (20 pixels each on average).
     Auto,
     /// Always.
     On,

@@ -103,7 +103,7 @@ pub enum Wireframe {
 
 /// The mean number of pixels a visible triangle must cover for [`Wireframe::Auto`] to draw
 /// the wireframe: below it the lines would cover most of the surface and hide its colours.
-pub const WIRE_MIN_PIXELS: f64 = 40.0;
+pub const WIRE_MIN_PIXELS: f64 = 20.0;
 
 /// Options of [`render`], with their defaults.
 #[derive(Clone, Debug, PartialEq)]

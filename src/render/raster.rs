@@ -6,7 +6,8 @@
 //! so the result does not depend on anything but the input). The second colours each pixel
 //! from its face: the face colour times a head-light shading of the face normal, and the
 //! wireframe colour within half a pixel of one of the face's projected edges, which draws
-//! the edges of the visible faces only (hidden lines are never drawn).
+//! the edges of the visible faces only (hidden lines are never drawn), and only of faces
+//! large enough on screen to show their colour between the lines.
 
 use super::{Image, Wireframe, WIRE, WIRE_MIN_PIXELS};
 use crate::mesh::TriMesh;
@@ -308,9 +309,17 @@ fn mean_face_pixels(rasters: &[Raster], n_faces: usize) -> f64 {
     pixels as f64 / faces.max(1) as f64
 }
 
-/// Whether the pixel centre `c` lies within half a line of an edge of face `f` on screen.
+/// Faces smaller than this on screen (pixels, e.g. seen at a grazing angle) get no lines:
+/// their lines would cover them and draw a black band along the silhouette.
+const WIRE_FACE_MIN_PIXELS: f64 = 12.0;
+
+/// Whether the pixel centre `c` lies within half a line of an edge of face `f` on screen
+/// (never for a face smaller than [`WIRE_FACE_MIN_PIXELS`] there).
 fn near_edge(mesh: &TriMesh, r: &Raster, f: usize, c: [f64; 2]) -> bool {
     let p = mesh.triangles[f].map(|v| r.screen[v.idx()]);
+    if 0.5 * edge(p[0], p[1], p[2]).abs() < WIRE_FACE_MIN_PIXELS {
+        return false;
+    }
     (0..3).any(|i| {
         let (a, b) = (p[(i + 1) % 3], p[(i + 2) % 3]);
         let len = (b[0] - a[0]).hypot(b[1] - a[1]);
