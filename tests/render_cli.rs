@@ -54,6 +54,22 @@ fn pixels(rgb: &[u8]) -> impl Iterator<Item = [u8; 3]> + '_ {
     rgb.chunks_exact(3).map(|c| [c[0], c[1], c[2]])
 }
 
+/// How many colours of the patch palette are drawn (shaded: a pixel is a palette colour
+/// times a factor, within rounding).
+fn palette_colours_seen(rgb: &[u8]) -> usize {
+    let seen: std::collections::BTreeSet<[u8; 3]> = pixels(rgb).collect();
+    conemesh::render::PATCH_PALETTE
+        .iter()
+        .filter(|c| {
+            seen.iter().any(|p| {
+                let k = (0..3).max_by_key(|&k| c[k]).unwrap_or(0);
+                let s = f64::from(p[k]) / f64::from(c[k].max(1));
+                s > 0.4 && (0..3).all(|j| (f64::from(p[j]) - s * f64::from(c[j])).abs() <= 2.0)
+            })
+        })
+        .count()
+}
+
 fn write(dir: &Path, name: &str, mesh: &TriMesh) -> PathBuf {
     let p = dir.join(name);
     conemesh::io::write_mesh(&p, mesh).expect("write mesh");
@@ -138,8 +154,10 @@ fn remesh_writes_the_picture_and_the_patches_that_render_draws() {
     ]));
     let (_, _, rgb) = decode(&pic);
     assert!(!pixels(&rgb).any(|c| c == [255, 0, 255]));
-    let distinct: std::collections::BTreeSet<[u8; 3]> = pixels(&rgb).collect();
-    assert!(distinct.len() > 20, "{}", distinct.len());
+    // Neighbouring patches differ: at least three palette colours on a closed surface (the
+    // colour bar shows all of them: only the views are counted).
+    let views = &rgb[..3 * 1500 * 500];
+    assert!(palette_colours_seen(views) >= 3);
     // The patch file of another mesh: the count is named, nothing written.
     let other = write(dir.path(), "other.off", &generators::icosphere(1.0, 1));
     let none = dir.path().join("none.png");
@@ -262,6 +280,29 @@ fn bad_inputs_fail_with_a_named_cause_and_no_file() {
         .filter(|n| n.starts_with(conemesh::io::TEMP_PREFIX))
         .collect();
     assert!(names.is_empty(), "{names:?}");
+}
+
+#[test]
+fn the_patch_property_of_a_patches_ply_is_drawn_without_a_patch_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let ply = dir.path().join("p.ply");
+    ok(&conemesh(&[&"patches", &"--seed", &"3", &"-o", &ply]));
+    let pic = dir.path().join("p.png");
+    ok(&conemesh(&[
+        &"render",
+        &ply,
+        &"-o",
+        &pic,
+        &"--color",
+        &"patch",
+        &"--width",
+        &"600",
+        &"--height",
+        &"260",
+    ]));
+    let (_, _, rgb) = decode(&pic);
+    // The views only (the colour bar shows the whole palette).
+    assert!(palette_colours_seen(&rgb[..3 * 600 * 200]) >= 3);
 }
 
 /// A shared mesh, coloured by q against itself and by distance to itself.
