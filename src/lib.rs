@@ -17,6 +17,7 @@
 //! - [`improve`]: Sec. 3.4, connectivity and vertex position updates on the surface, and
 //!   Algorithm 2's planar updates (Eq. 5-6).
 //! - [`quality`], [`report`]: Sec. 4.1, the yardstick; JSON and plots.
+//! - [`render`]: pictures of a surface coloured by q, angle, patch or distance (Fig. 3, 6).
 //! - [`registry`], [`contract`]: the extension points' tables and their contract checks.
 //! - [`boundary`]: the input's boundary curves the output's boundary lies on (ours).
 //! - [`suite`]: the analytic benchmark cases (surfaces with user-style metrics).
@@ -41,6 +42,7 @@ pub mod predicates;
 pub mod quality;
 pub mod registry;
 pub mod remesh2d;
+pub mod render;
 pub mod repair;
 pub mod report;
 pub mod stitch;

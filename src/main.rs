@@ -36,6 +36,9 @@ enum Command {
     /// Remesh a surface anisotropically (Algorithm 1).
     #[command(allow_negative_numbers = true)]
     Remesh(cli::remesh::RemeshArgs),
+    /// Draw a mesh as a PNG: front, side and iso views, faces coloured by q, smallest angle,
+    /// patch or distance to a reference, with a colour bar.
+    Render(cli::render::RenderArgs),
     /// List the registered patch strategies, parameterizers and planar remeshers.
     Stages(cli::stages::StagesArgs),
 }
@@ -50,6 +53,7 @@ fn main() -> ExitCode {
         Command::Patches(a) => cli::patches::run(a),
         Command::Param(a) => cli::param::run(a),
         Command::Remesh(a) => cli::remesh::run(a),
+        Command::Render(a) => cli::render::run(a),
         Command::Stages(a) => cli::stages::run(a),
     };
     match result {

@@ -36,7 +36,10 @@ pub enum ReportError {
 }
 
 /// The font family name the plots use (registered by [`font_available`]).
-const FAMILY: &str = "sans-serif";
+const FAMILY: &str = FONT_FAMILY;
+
+/// The font family name of the text in plots and pictures (registered by [`font_available`]).
+pub(crate) const FONT_FAMILY: &str = "sans-serif";
 
 /// Where TrueType fonts usually live (Debian/Ubuntu, Fedora/Arch, macOS, Windows).
 const FONT_CANDIDATES: &[&str] = &[

@@ -42,6 +42,7 @@ __all__ = [
     "check",
     "patches",
     "param",
+    "render",
     "batch",
     "Error",
     "InputError",
@@ -210,7 +211,8 @@ def remesh(V, F, metric=None, **options):
         joined), ``no_improve=False``, ``max_patches=None``, ``no_self_intersections=False``,
         ``repair=False`` (weld, drop zero-area faces, orient, split non-manifold elements
         first; the report's ``repair`` lists every change), ``quiet=False`` (no progress
-        bar on stderr). Files: ``report``, ``plots``, ``write_metric``,
+        bar on stderr). Files: ``report``, ``plots`` (with ``mesh.png``, the output coloured
+        by q), ``write_patches`` (the patch of each output face), ``write_metric``,
         ``write_input_metric``, ``debug_dir`` (``None``: an array has no folder to write
         offending patches into); checked before the run and written together (all or none).
 
@@ -487,4 +489,83 @@ def param(V, F, *, method="sd", report=False):
 
 # `conemesh.batch` is the module `conemesh/batch.py`, which is also callable as the function
 # `conemesh.batch.batch`: importing the module must not shadow the function.
+def render(
+    V,
+    F,
+    *,
+    color="q",
+    metric=None,
+    reference=None,
+    patches=None,
+    width=1500,
+    height=600,
+    wireframe="auto",
+):
+    """Draw a mesh as ``conemesh render`` does: the front, side and iso views side by side,
+    faces coloured by ``color``, above a colour bar.
+
+    Parameters
+    ----------
+    V : array_like, shape (n, 3)
+        Vertex positions.
+    F : array_like, shape (m, 3)
+        Triangles.
+    color : {"q", "min-angle", "patch", "distance", "none"}, default "q"
+        ``q`` (2√3·a/(p·h) in the metric) or ``min-angle`` (the smallest angle in the
+        metric), both with the faces whose smallest angle is below 20° in magenta (the
+        paper's Fig. 6); ``patch`` (needs ``patches``; neighbouring patches in different
+        colours, Fig. 3); ``distance`` (to ``reference``, in % of its bounding-box diagonal);
+        ``none``.
+    metric : array_like of shape (n, 3, 3) or (n_ref, 3, 3), str or os.PathLike, optional
+        The metric of ``q`` and ``min-angle``: one tensor per vertex of ``V`` (as
+        ``remesh --write-metric`` writes), or per vertex of the reference, or a ``.sol``
+        path. Default: the curvature metric of the reference, or of ``(V, F)`` without one.
+    reference : tuple (V_ref, F_ref), optional
+        The reference (input) surface.
+    patches : array_like of int, shape (m,), optional
+        The patch of each face; negative for none.
+    width, height : int, default 1500, 600
+        Picture size in pixels.
+    wireframe : {"auto", "on", "off"}, default "auto"
+        The faces' edges; ``auto`` draws them when the visible triangles are large enough.
+
+    Returns
+    -------
+    numpy.ndarray of uint8, shape (height, width, 3)
+        The RGB picture, row by row from the top.
+    """
+    m_arr, m_path = _metric(metric)
+    v_ref = f_ref = None
+    if reference is not None:
+        try:
+            v_ref, f_ref = reference
+        except (TypeError, ValueError):
+            raise InputError("reference must be a pair (V_ref, F_ref)") from None
+        v_ref, f_ref = _vertices(v_ref, "V_ref"), _faces(f_ref, "F_ref")
+    ids = None
+    if patches is not None:
+        ids = np.asarray(patches)
+        if ids.ndim != 1 or ids.dtype.kind not in "iu":
+            raise InputError(
+                f"patches must be a 1-D integer array, got shape {ids.shape}, dtype {ids.dtype}"
+            )
+        ids = np.ascontiguousarray(ids, dtype=np.int64)
+    for name, value in (("width", width), ("height", height)):
+        if not isinstance(value, (int, np.integer)) or not 0 < value < 2**32:
+            raise OptionError(f"{name} must be a positive integer, got {value!r}")
+    return _conemesh.render(
+        _vertices(V),
+        _faces(F),
+        str(color),
+        m_arr,
+        m_path,
+        v_ref,
+        f_ref,
+        ids,
+        int(width),
+        int(height),
+        str(wireframe),
+    )
+
+
 from . import batch  # noqa: E402

@@ -46,6 +46,7 @@ def remesh(
     max_patches: int | None = None,
     report: str | os.PathLike[str] | None = None,
     plots: str | os.PathLike[str] | None = None,
+    write_patches: str | os.PathLike[str] | None = None,
     write_metric: str | os.PathLike[str] | None = None,
     write_input_metric: str | os.PathLike[str] | None = None,
     debug_dir: str | os.PathLike[str] | None = None,
@@ -92,6 +93,18 @@ def evaluate(
     name: str = "output",
 ) -> dict[str, Any]: ...
 def check(V: npt.ArrayLike, F: npt.ArrayLike, *, self_intersections: bool = True) -> dict[str, Any]: ...
+def render(
+    V: npt.ArrayLike,
+    F: npt.ArrayLike,
+    *,
+    color: Literal["q", "min-angle", "patch", "distance", "none"] = "q",
+    metric: npt.ArrayLike | PathLike | None = None,
+    reference: tuple[npt.ArrayLike, npt.ArrayLike] | None = None,
+    patches: npt.ArrayLike | None = None,
+    width: int = 1500,
+    height: int = 600,
+    wireframe: Literal["auto", "on", "off"] = "auto",
+) -> npt.NDArray[np.uint8]: ...
 def patches(
     V: npt.ArrayLike,
     F: npt.ArrayLike,

@@ -15,7 +15,9 @@ use conemesh::{TriMesh, VertexId};
 use errors::{Attr, Failure};
 use nalgebra::{Matrix3, Point3};
 use numpy::ndarray::{Array1, Array2};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -643,6 +645,111 @@ fn param<'py>(
     Ok((arr.into_pyarray(py), report))
 }
 
+// ---------------------------------------------------------------- render
+
+/// The metric of `render`: per vertex of the mesh drawn when its count matches, else per
+/// vertex of the reference (as `conemesh render --metric`); `true` for the mesh's.
+fn render_metric(
+    array: Option<PyReadonlyArray3<'_, f64>>,
+    path: Option<PathBuf>,
+    n_mesh: usize,
+    n_reference: Option<usize>,
+) -> PyResultOf<Option<(Vec<Matrix3<f64>>, bool)>> {
+    let count = match (&array, &path) {
+        (Some(a), _) => a.as_array().shape()[0],
+        (None, Some(p)) => match conemesh::io::sol::read_sol(p, n_mesh) {
+            Ok(m) => return Ok(Some((m, true))),
+            Err(conemesh::io::sol::SolError::CountMismatch { found, .. }) => found,
+            Err(e) => return Err(errors::from_sol(&e)),
+        },
+        (None, None) => return Ok(None),
+    };
+    let on_mesh = count == n_mesh || n_reference != Some(count);
+    let n = if on_mesh { n_mesh } else { count };
+    Ok(metric_of(array, path, n)?.map(|m| (m, on_mesh)))
+}
+
+/// `conemesh render` on arrays: the picture as an `(H, W, 3)` uint8 array.
+#[pyfunction]
+#[pyo3(signature = (v, f, color, metric_array, metric_path, v_ref, f_ref, patches, width, height, wireframe))]
+#[allow(clippy::too_many_arguments)]
+fn render<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'py, f64>,
+    f: PyReadonlyArray2<'py, i64>,
+    color: String,
+    metric_array: Option<PyReadonlyArray3<'py, f64>>,
+    metric_path: Option<PathBuf>,
+    v_ref: Option<PyReadonlyArray2<'py, f64>>,
+    f_ref: Option<PyReadonlyArray2<'py, i64>>,
+    patches: Option<PyReadonlyArray1<'py, i64>>,
+    width: u32,
+    height: u32,
+    wireframe: String,
+) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    use conemesh::render::{ColorBy, RenderError, RenderOptions, Sources, VertexMetric, Wireframe};
+    let mesh = raise(py, mesh_of(&v, &f))?;
+    let reference = match (&v_ref, &f_ref) {
+        (Some(rv), Some(rf)) => Some(raise(py, mesh_of(rv, rf))?),
+        _ => None,
+    };
+    let color = raise(
+        py,
+        ColorBy::parse(&color).map_err(|e| Failure::option(format!("color: {e}"))),
+    )?;
+    let wireframe = raise(
+        py,
+        match wireframe.as_str() {
+            "auto" => Ok(Wireframe::Auto),
+            "on" => Ok(Wireframe::On),
+            "off" => Ok(Wireframe::Off),
+            w => Err(Failure::option(format!(
+                "wireframe: expected auto, on or off, got {w:?}"
+            ))),
+        },
+    )?;
+    let n_ref = reference.as_ref().map(|r| r.n_vertices());
+    let metric = raise(
+        py,
+        render_metric(metric_array, metric_path, mesh.n_vertices(), n_ref),
+    )?;
+    let patches: Option<Vec<Option<conemesh::PatchId>>> = patches.map(|p| {
+        p.as_array()
+            .iter()
+            .map(|&i| u32::try_from(i).ok().map(conemesh::PatchId))
+            .collect()
+    });
+    let opts = RenderOptions {
+        width,
+        height,
+        wireframe,
+        ..Default::default()
+    };
+    let img = py.detach(|| {
+        let sources = Sources {
+            metric: metric.as_ref().map(|(m, on_mesh)| match on_mesh {
+                true => VertexMetric::OnMesh(m),
+                false => VertexMetric::OnReference(m),
+            }),
+            reference: reference.as_ref(),
+            patches: patches.as_deref(),
+            ..Default::default()
+        };
+        let drawn = conemesh::render::face_colors(&mesh, color, &sources)
+            .and_then(|c| conemesh::render::render(&mesh, &c, &opts));
+        drawn.map(|(img, _)| img).map_err(|e| match &e {
+            RenderError::Metric(m) => errors::from_metric(m),
+            RenderError::EmptyMesh | RenderError::NonFinite { .. } => Failure::input(e.to_string()),
+            _ => Failure::option(e.to_string()),
+        })
+    });
+    let img = raise(py, img)?;
+    let shape = (img.height as usize, img.width as usize, 3);
+    let arr = numpy::ndarray::Array3::from_shape_vec(shape, img.rgb)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("picture buffer: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
 #[pymodule]
 fn _conemesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
@@ -654,6 +761,7 @@ fn _conemesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(patches, m)?)?;
     m.add_function(wrap_pyfunction!(param, m)?)?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -7,6 +7,7 @@ pub mod eval;
 pub mod param;
 pub mod patches;
 pub mod remesh;
+pub mod render;
 pub mod stages;
 
 mod outputs;

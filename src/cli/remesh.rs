@@ -87,9 +87,16 @@ pub struct RemeshArgs {
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// Write quality histograms (PNG) into this directory (with `--improve`, also the smallest
-    /// angles before and after Algorithm 2).
+    /// angles before and after Algorithm 2), and `mesh.png`, the picture of the output
+    /// coloured by q in the run's metric, faces with a smallest angle below 20° in magenta
+    /// (as `conemesh render --color q` with `--write-metric`'s tensors).
     #[arg(long)]
     pub plots: Option<PathBuf>,
+    /// Write the patch that made each output face (one line per face: the patch id in order
+    /// of creation, or `-` for an input face no patch replaced), for `render --color patch
+    /// --patches FILE`.
+    #[arg(long, value_name = "FILE")]
+    pub write_patches: Option<PathBuf>,
     /// Write the metric at the output vertices (Medit .sol, file units): the metric the mesh
     /// was built to, a user's tensors restricted to the surface's tangent plane.
     #[arg(long)]
@@ -439,6 +446,12 @@ pub fn stage_side_outputs(
             .bytes(p, &bytes)
             .with_context(|| format!("writing {}", p.display()))?;
     }
+    if let Some(p) = &args.write_patches {
+        let bytes = conemesh::io::patches::face_patches_bytes(&out.unit.face_patch);
+        outputs
+            .bytes(p, &bytes)
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
     if let Some(p) = &args.report {
         outputs
             .bytes(p, serde_json::to_string_pretty(report)?.as_bytes())
@@ -457,6 +470,19 @@ pub fn stage_side_outputs(
             ],
         )
         .with_context(|| format!("writing plots into {}", dir.display()))?;
+        let colors = conemesh::render::quality_face_colors(
+            &out.mesh,
+            &out.output_metric(),
+            conemesh::render::ColorBy::Q,
+        );
+        let picture = dir.join("mesh.png");
+        let (img, _) = conemesh::render::render(&out.mesh, &colors, &Default::default())
+            .with_context(|| format!("drawing {}", picture.display()))?;
+        let bytes = img
+            .png()
+            .with_context(|| format!("drawing {}", picture.display()))?;
+        std::fs::write(staged.join("mesh.png"), bytes)
+            .with_context(|| format!("writing {}", picture.display()))?;
         if let Some(i) = &out.unit.report.improvement {
             conemesh::report::write_improvement_plot(
                 &staged,
@@ -480,6 +506,7 @@ pub fn check_output_paths(args: &RemeshArgs, mesh_output: bool) -> anyhow::Resul
         mesh_output.then_some(("-o", &args.output)),
         args.report.as_ref().map(|p| ("--report", p)),
         args.write_metric.as_ref().map(|p| ("--write-metric", p)),
+        args.write_patches.as_ref().map(|p| ("--write-patches", p)),
         args.write_input_metric
             .as_ref()
             .map(|p| ("--write-input-metric", p)),
