@@ -23,6 +23,7 @@
 
 pub mod boundary;
 pub mod check;
+pub mod compare;
 pub mod contract;
 pub mod error;
 pub mod features;
