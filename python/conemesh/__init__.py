@@ -5,8 +5,9 @@ float64 array of shape ``(n, 3)`` (vertex positions) and an integer array of sha
 ``(m, 3)`` (triangles as 0-based vertex ids, counter-clockwise seen from outside).
 
 Functions: :func:`remesh`, :func:`read`, :func:`write`, :func:`evaluate`, :func:`check`,
-:func:`patches`, :func:`param`, :func:`remesh_options`, and :func:`batch` (corpus runs on
-Dask, in :mod:`conemesh.batch`). Errors are :class:`Error` and its subclasses.
+:func:`patches`, :func:`param`, :func:`remesh_options`, :func:`batch` (corpus runs on
+Dask, in :mod:`conemesh.batch`) and :func:`compare` (configurations × inputs × seeds on the
+same engine, in :mod:`conemesh.compare`). Errors are :class:`Error` and its subclasses.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ __all__ = [
     "patches",
     "param",
     "batch",
+    "compare",
     "Error",
     "InputError",
     "OptionError",
@@ -488,3 +490,4 @@ def param(V, F, *, method="sd", report=False):
 # `conemesh.batch` is the module `conemesh/batch.py`, which is also callable as the function
 # `conemesh.batch.batch`: importing the module must not shadow the function.
 from . import batch  # noqa: E402
+from . import compare  # noqa: E402
