@@ -302,3 +302,84 @@ fn bad_inputs_are_refused_before_anything_runs() {
         text(&o)
     );
 }
+
+/// A stand-in `conemesh`: `remesh` runs the real binary (or dies of SIGSEGV when its
+/// arguments hold `--crash`), `render` copies `png` to its `-o` (or, with `render: false`,
+/// answers as a binary without the subcommand does).
+fn fake_conemesh(dir: &Path, png: &Path, render: bool) -> PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let real = env!("CARGO_BIN_EXE_conemesh");
+    let render_case = if render {
+        format!(
+            "  render) [ \"$2\" = --help ] && exit 0; cp '{}' \"$4\"; exit 0;;",
+            png.display()
+        )
+    } else {
+        "  render) echo \"error: unrecognized subcommand 'render'\" >&2; exit 2;;".to_string()
+    };
+    let script = format!(
+        "#!/bin/sh\ncase \"$1\" in\n{render_case}\n  remesh) for a in \"$@\"; do [ \"$a\" = --crash ] && kill -SEGV $$; done; exec '{real}' \"$@\";;\nesac\nexit 2\n"
+    );
+    let p = dir.join(if render {
+        "fake-render"
+    } else {
+        "fake-norender"
+    });
+    std::fs::write(&p, script).expect("write script");
+    std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+    p
+}
+
+#[test]
+fn pictures_are_drawn_where_render_exists_and_a_crash_is_a_row() {
+    use conemesh::compare::{page, Comparison, Config, Grid, Status};
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mesh = torus(dir.path(), "torus.off");
+    let png = dir.path().join("picture.png");
+    conemesh::report::write_strip_plot(&png, "a picture", "y", &[("a", vec![1.0, 2.0])])
+        .expect("png");
+    let inputs = conemesh::compare::config::collect_inputs(&[mesh]).expect("inputs");
+    let grid = |exe: PathBuf| Grid {
+        exe,
+        configs: vec![
+            Config::new("base", vec![]).expect("config"),
+            Config::new("boom", vec!["--crash".into()]).expect("config"),
+        ],
+        inputs: inputs.clone(),
+        seeds: vec![1],
+        timeout: std::time::Duration::from_secs(60),
+        jobs: 2,
+        pictures: true,
+    };
+    let out = dir.path().join("with");
+    std::fs::create_dir(&out).expect("mkdir");
+    let g = grid(fake_conemesh(dir.path(), &png, true));
+    let runs = g.run(&g.jobs(), &out, &|_| {}).expect("grid");
+    assert_eq!(runs[0].status, Status::Ok, "{:?}", runs[0].error);
+    assert_eq!(runs[0].picture, Ok("base--torus--s1.png".to_string()));
+    assert!(out.join("base--torus--s1.png").is_file());
+    assert_eq!(runs[1].status, Status::Crashed);
+    assert!(runs[1].error.contains("signal"), "{}", runs[1].error);
+    assert!(runs[1].picture.is_err(), "no output, no picture");
+    let c = Comparison::of(&g, runs);
+    page::write_plots(&out, &c).expect("plots");
+    let html = page::html(&c, &out);
+    assert_eq!(
+        html.matches("<figure class=\"picture\">").count(),
+        1,
+        "the ok run's picture"
+    );
+    assert!(page::markdown(&c).contains("| torus | boom | 1 | crashed |"));
+
+    // A binary without `render`: every row says so, and the run is still ok.
+    let out = dir.path().join("without");
+    std::fs::create_dir(&out).expect("mkdir");
+    let g = grid(fake_conemesh(dir.path(), &png, false));
+    let runs = g.run(&g.jobs()[..1], &out, &|_| {}).expect("grid");
+    assert_eq!(runs[0].status, Status::Ok);
+    let why = runs[0].picture.clone().expect_err("no picture");
+    assert!(
+        why.contains("no picture") && why.contains("render"),
+        "{why}"
+    );
+}
