@@ -226,8 +226,6 @@ impl Grid {
         let c = &self.configs[job.config];
         let input = &self.inputs[job.input];
         let files = RunFiles::of(&c.name, &input.name, job.seed);
-        let mut cmd = Command::new(&self.exe);
-        cmd.args(self.remesh_args(job, dir));
         let mut log = Vec::new();
         let mut rec = RunRecord {
             config: c.name.clone(),
@@ -241,6 +239,27 @@ impl Grid {
             picture: Err("no output".into()),
             wall: None,
         };
+        self.remesh(job, dir, &mut log, &mut rec);
+        if rec.status == Status::Ok {
+            rec.picture = match render {
+                None => Err("pictures off".into()),
+                Some(Err(why)) => Err(why.clone()),
+                Some(Ok(())) => self.picture(input, dir, &files, &mut log),
+            };
+        }
+        let log_path = dir.join(&files.log);
+        std::fs::write(&log_path, &log).map_err(|source| super::CompareError::Os {
+            path: log_path.display().to_string(),
+            source,
+        })?;
+        Ok(rec)
+    }
+
+    /// The `conemesh remesh` process of one cell: its status, error, wall time, output hash
+    /// and report into `rec`, its stdout and stderr onto `log`.
+    fn remesh(&self, job: Job, dir: &Path, log: &mut Vec<u8>, rec: &mut RunRecord) {
+        let mut cmd = Command::new(&self.exe);
+        cmd.args(self.remesh_args(job, dir));
         match run_timed(&mut cmd, self.timeout) {
             Err(e) => {
                 rec.status = match e {
@@ -254,7 +273,7 @@ impl Grid {
                 log.extend_from_slice(&f.stderr);
                 rec.wall = Some(f.wall);
                 if f.status.success() {
-                    match read_result(dir, &files) {
+                    match read_result(dir, &rec.files) {
                         Ok((sha, result)) => {
                             rec.output_sha256 = Some(sha);
                             rec.result = Some(result);
@@ -277,19 +296,6 @@ impl Grid {
                 }
             }
         }
-        if rec.status == Status::Ok {
-            rec.picture = match render {
-                None => Err("pictures off".into()),
-                Some(Err(why)) => Err(why.clone()),
-                Some(Ok(())) => self.picture(input, dir, &files, &mut log),
-            };
-        }
-        let log_path = dir.join(&files.log);
-        std::fs::write(&log_path, &log).map_err(|source| super::CompareError::Os {
-            path: log_path.display().to_string(),
-            source,
-        })?;
-        Ok(rec)
     }
 
     /// `conemesh render OUT -o PIC --color q --metric OUT.sol --reference INPUT`.

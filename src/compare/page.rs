@@ -289,6 +289,16 @@ pub fn html(c: &Comparison, dir: &Path) -> String {
         s.push_str("</tr>\n");
     }
     s.push_str("</table>\n");
+    html_paired(&mut s, c);
+    html_outputs(&mut s, c, dir);
+    s.push_str("<pre id=\"page-check\">pending</pre>\n<script>\n");
+    s.push_str(CHECK_SCRIPT);
+    s.push_str("</script>\n</body></html>\n");
+    s
+}
+
+/// The paired table of [`html`] (with more than one configuration).
+fn html_paired(s: &mut String, c: &Comparison) {
     if c.configs.len() > 1 {
         let _ = writeln!(s, "<h2>Against <code>{}</code>, paired over (input, seed)</h2><p>Bold: sign-test p &lt; 0.05 and the 95 % bootstrap interval leaves 0 out.</p>", esc(&c.configs[0].name));
         s.push_str("<table id=\"paired\"><tr><th>measure</th><th>configuration</th><th>pairs</th><th>mean diff</th><th>95 % interval</th><th>sign p</th><th>W/T/L</th></tr>\n");
@@ -317,9 +327,13 @@ pub fn html(c: &Comparison, dir: &Path) -> String {
         }
         s.push_str("</table>\n");
     }
+}
+
+/// The plots and the outputs' table with their pictures, for [`html`].
+fn html_outputs(s: &mut String, c: &Comparison, dir: &Path) {
     s.push_str("<h2>Plots</h2>\n");
     for (file, caption) in plot_files() {
-        figure(&mut s, dir, &file, &caption, "plot");
+        figure(s, dir, &file, &caption, "plot");
     }
     s.push_str("<h2>Outputs</h2>\n<table id=\"runs\"><tr><th>input</th><th>configuration</th><th>seed</th><th>status</th><th>picture</th></tr>\n");
     for r in &c.runs {
@@ -337,17 +351,14 @@ pub fn html(c: &Comparison, dir: &Path) -> String {
             }
         );
         match &r.picture {
-            Ok(file) => figure(&mut s, dir, file, &r.files.output, "picture"),
+            Ok(file) => figure(s, dir, file, &r.files.output, "picture"),
             Err(why) => {
                 let _ = write!(s, "<span class=\"no-picture\">{}</span>", esc(why));
             }
         }
         s.push_str("</td></tr>\n");
     }
-    s.push_str("</table>\n<pre id=\"page-check\">pending</pre>\n<script>\n");
-    s.push_str(CHECK_SCRIPT);
-    s.push_str("</script>\n</body></html>\n");
-    s
+    s.push_str("</table>\n");
 }
 
 /// Counts the images, those loaded (`naturalWidth > 0`) and those of one colour (drawn into
