@@ -209,9 +209,10 @@ impl Grid {
                 });
             }
         });
+        // A worker's panic is re-raised by `scope` above, so every slot is filled here.
         records
             .into_inner()
-            .unwrap_or_default()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
             .into_iter()
             .map(|r| r.expect("every job ran"))
             .collect()
