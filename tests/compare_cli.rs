@@ -132,6 +132,28 @@ fn compare_tables_the_grid_and_check_finds_an_edited_option() {
         assert!(out.join(plot).is_file(), "{plot}");
     }
 
+    // The same grid again (another --jobs): the same snapshot, byte for byte.
+    let again = dir.path().join("again");
+    let o = conemesh(&[
+        "compare",
+        s(&mesh),
+        "-c",
+        "base=",
+        "-c",
+        "kring=--strategy kring --strategy-opt rings=4",
+        "--seeds",
+        "1-2",
+        "-o",
+        s(&again),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let bytes = |d: &Path| std::fs::read(d.join("snapshot.json")).expect("snapshot");
+    assert!(
+        bytes(&out) == bytes(&again),
+        "snapshot.json depends on nothing but the grid"
+    );
+
     // The snapshot reruns to the same bytes.
     let snap = out.join("snapshot.json");
     let sj = json(&snap);
