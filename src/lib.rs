@@ -21,9 +21,12 @@
 //! - [`registry`], [`contract`]: the extension points' tables and their contract checks.
 //! - [`boundary`]: the input's boundary curves the output's boundary lies on (ours).
 //! - [`suite`]: the analytic benchmark cases (surfaces with user-style metrics).
+//! - [`compare`]: comparisons of configurations over inputs × seeds, their statistics and
+//!   snapshots (ours).
 
 pub mod boundary;
 pub mod check;
+pub mod compare;
 pub mod contract;
 pub mod error;
 pub mod features;

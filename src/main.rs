@@ -24,6 +24,10 @@ enum Command {
     Bench(cli::bench::BenchArgs),
     /// Check a mesh: topology, manifoldness, degenerate faces, self-intersections.
     Check(cli::check::CheckArgs),
+    /// Compare named configurations of `remesh` over inputs × seeds, one process per run:
+    /// Table-1 rows as mean ± sd, paired statistics against the first configuration, plots,
+    /// a static HTML page and a snapshot; `--check snapshot.json` reruns a snapshot.
+    Compare(cli::compare::CompareArgs),
     /// Convert a mesh between formats (by file extension).
     Convert(cli::convert::ConvertArgs),
     /// Score a remeshed surface against its input (Table-1 quality, fidelity, validity).
@@ -48,6 +52,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Bench(a) => cli::bench::run(a),
         Command::Check(a) => cli::check::run(a),
+        Command::Compare(a) => cli::compare::run(a),
         Command::Convert(a) => cli::convert::run(a),
         Command::Eval(a) => cli::eval::run(a),
         Command::Patches(a) => cli::patches::run(a),

@@ -310,6 +310,104 @@ pub fn write_improvement_plot(
     Ok(p)
 }
 
+/// Write a strip plot to `path` (PNG): one column per `(label, values)` group, each value a
+/// dot (spread sideways by its index, so equal values stay visible) and the group's mean a
+/// bar; `title` above, `y_desc` on the vertical axis. Used by `conemesh compare` (one plot
+/// per measure, one column per configuration).
+pub fn write_strip_plot(
+    path: &Path,
+    title: &str,
+    y_desc: &str,
+    groups: &[(&str, Vec<f64>)],
+) -> Result<(), ReportError> {
+    let err = |e: &dyn std::fmt::Display| ReportError::Plot {
+        path: path.display().to_string(),
+        detail: e.to_string(),
+    };
+    let text = font_available();
+    let all: Vec<f64> = groups
+        .iter()
+        .flat_map(|g| g.1.iter().copied())
+        .filter(|v| v.is_finite())
+        .collect();
+    let (lo, hi) = all
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let (lo, hi) = if all.is_empty() {
+        (0.0, 1.0)
+    } else {
+        // A margin of a tenth of the range (or of the value when all are equal).
+        let pad = ((hi - lo).max(hi.abs().max(1e-9) * 0.01)) * 0.1;
+        (lo - pad, hi + pad)
+    };
+    let root = BitMapBackend::new(path, (720, 480)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let n = groups.len().max(1);
+    let mut builder = ChartBuilder::on(&root);
+    builder.margin(16);
+    if text {
+        builder
+            .caption(title, (FAMILY, 22))
+            .x_label_area_size(40)
+            .y_label_area_size(80);
+    } else {
+        builder.x_label_area_size(8).y_label_area_size(8);
+    }
+    let mut chart = builder
+        .build_cartesian_2d(-0.5..(n as f64 - 0.5), lo..hi)
+        .map_err(|e| err(&e))?;
+    let label = |x: &f64| {
+        let i = x.round();
+        if (x - i).abs() < 1e-6 && i >= 0.0 {
+            groups
+                .get(i as usize)
+                .map_or(String::new(), |g| g.0.to_string())
+        } else {
+            String::new()
+        }
+    };
+    let mut mesh = chart.configure_mesh();
+    mesh.disable_x_mesh();
+    if text {
+        mesh.x_labels(n)
+            .x_label_formatter(&label)
+            .y_desc(y_desc)
+            .label_style((FAMILY, 16))
+            .axis_desc_style((FAMILY, 18));
+    } else {
+        mesh.x_labels(0).y_labels(0);
+    }
+    mesh.draw().map_err(|e| err(&e))?;
+    for (gi, (_, values)) in groups.iter().enumerate() {
+        let color = COLORS[(gi + 1) % COLORS.len()];
+        let k = values.len().max(1) as f64;
+        let dots = values
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.is_finite())
+            .map(move |(i, &v)| {
+                let x = gi as f64 + 0.3 * ((i as f64 + 0.5) / k - 0.5);
+                Circle::new((x, v), 5, color.filled())
+            });
+        chart.draw_series(dots).map_err(|e| err(&e))?;
+        let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+        if !finite.is_empty() {
+            let mean = finite.iter().sum::<f64>() / finite.len() as f64;
+            let x0 = gi as f64 - 0.25;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(x0, mean), (x0 + 0.5, mean)],
+                    BLACK.stroke_width(2),
+                )))
+                .map_err(|e| err(&e))?;
+        }
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,8 +5,9 @@ float64 array of shape ``(n, 3)`` (vertex positions) and an integer array of sha
 ``(m, 3)`` (triangles as 0-based vertex ids, counter-clockwise seen from outside).
 
 Functions: :func:`remesh`, :func:`read`, :func:`write`, :func:`evaluate`, :func:`check`,
-:func:`patches`, :func:`param`, :func:`remesh_options`, and :func:`batch` (corpus runs on
-Dask, in :mod:`conemesh.batch`). Errors are :class:`Error` and its subclasses.
+:func:`patches`, :func:`param`, :func:`remesh_options`, :func:`batch` (corpus runs on
+Dask, in :mod:`conemesh.batch`) and :func:`compare` (configurations × inputs × seeds on the
+same engine, in :mod:`conemesh.compare`). Errors are :class:`Error` and its subclasses.
 """
 
 from __future__ import annotations
@@ -44,6 +45,7 @@ __all__ = [
     "param",
     "render",
     "batch",
+    "compare",
     "Error",
     "InputError",
     "OptionError",
@@ -569,3 +571,4 @@ def render(
 
 
 from . import batch  # noqa: E402
+from . import compare  # noqa: E402

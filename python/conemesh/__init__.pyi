@@ -7,6 +7,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import batch as batch
+from . import compare as compare
 from ._errors import (
     CertificateError as CertificateError,
     Error as Error,

@@ -259,11 +259,15 @@ def batch(
     return df
 
 
-def _run(jobs: list[dict[str, Any]], client, workers: int | None) -> list[dict[str, Any]]:
+def _run(
+    jobs: list[dict[str, Any]], client, workers: int | None, task=None
+) -> list[dict[str, Any]]:
+    """``task`` (default :func:`run_one`) of every job on ``client`` or a local cluster."""
+    task = task or run_one
     if not jobs:
         return []
     if client is not None:
-        return client.gather(client.map(run_one, jobs, pure=False))
+        return client.gather(client.map(task, jobs, pure=False))
     from distributed import Client, LocalCluster
 
     n = workers or os.cpu_count() or 1
@@ -274,7 +278,7 @@ def _run(jobs: list[dict[str, Any]], client, workers: int | None) -> list[dict[s
         processes=False,
         dashboard_address=None,
     ) as cluster, Client(cluster) as c:
-        return c.gather(c.map(run_one, jobs, pure=False))
+        return c.gather(c.map(task, jobs, pure=False))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -19,7 +19,7 @@ pub use eval::{
 use crate::ids::{EdgeKey, VertexId};
 use crate::mesh::TriMesh;
 use nalgebra::{Matrix3, Point3, SymmetricEigen, Vector3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The quality of one triangle in the isotropic space of a metric (Sec. 3.3 "Quality
 /// evaluation", Sec. 4.1 (1)-(2)).
@@ -137,7 +137,7 @@ pub fn face_metric(vertex_metrics: &[Matrix3<f64>], f: [VertexId; 3]) -> Matrix3
 
 /// Table-1 statistics of a mesh in a metric (Sec. 4.1), plus the percentages and histograms
 /// used to compare with other remeshers.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct QualityStats {
     /// Number of triangles measured.
     pub faces: usize,

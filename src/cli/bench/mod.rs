@@ -20,6 +20,7 @@ mod side_by_side;
 mod tools;
 
 use anyhow::{bail, ensure, Context};
+use conemesh::compare::process::error_line;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -490,21 +491,6 @@ fn remove_stale(path: &Path) -> anyhow::Result<()> {
         }
         _ => Ok(()),
     }
-}
-
-/// The line of a failed child's stderr that names the error (or a panic's message), not a
-/// trailing hint.
-fn error_line(stderr: &str) -> &str {
-    stderr
-        .lines()
-        .find(|l| l.contains("panicked"))
-        .or_else(|| {
-            stderr
-                .lines()
-                .rev()
-                .find(|l| !l.trim().is_empty() && !l.starts_with("note:"))
-        })
-        .unwrap_or("no message")
 }
 
 /// A mesh's name in the table and in its output files: the file stem.

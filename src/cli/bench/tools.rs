@@ -2,12 +2,12 @@
 //! with `--mmg`): finding MMG and its version, running a child with a timeout and timing it,
 //! and scoring an output by `conemesh eval`, so that every tool is measured by one yardstick.
 
-use super::{cell, error_line};
+use super::cell;
 use anyhow::ensure;
-use std::io::Read;
+use conemesh::compare::process::error_line;
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitStatus, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 /// MMG's surface remesher, looked up on PATH.
 pub(super) const MMG_NAME: &str = "mmgs_O3";
@@ -98,74 +98,11 @@ impl Header {
     }
 }
 
-/// A finished child process.
-pub(super) struct Finished {
-    pub status: ExitStatus,
-    pub stdout: Vec<u8>,
-    pub stderr: Vec<u8>,
-    /// Wall-clock seconds from spawn to exit.
-    pub wall: f64,
-}
+pub(super) use conemesh::compare::process::Finished;
 
-/// Run `cmd` (stdin closed, stdout and stderr captured) for at most `timeout`; a child still
-/// running then is killed. The wall time is the whole process's, spawn to exit.
+/// [`conemesh::compare::process::run_timed`] with the error as text, as the rows hold it.
 pub(super) fn run_timed(cmd: &mut Command, timeout: Duration) -> Result<Finished, String> {
-    let t0 = Instant::now();
-    let mut child = cmd
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| format!("cannot start {:?}: {e}", cmd.get_program()))?;
-    // Readers drain the pipes while we wait, so a chatty child never blocks on a full pipe.
-    let drain = |pipe: Option<Box<dyn Read + Send>>| {
-        std::thread::spawn(move || {
-            let mut buf = Vec::new();
-            if let Some(mut p) = pipe {
-                let _ = p.read_to_end(&mut buf);
-            }
-            buf
-        })
-    };
-    let out = drain(
-        child
-            .stdout
-            .take()
-            .map(|p| Box::new(p) as Box<dyn Read + Send>),
-    );
-    let err = drain(
-        child
-            .stderr
-            .take()
-            .map(|p| Box::new(p) as Box<dyn Read + Send>),
-    );
-    // Poll with a short, growing sleep: the timing error stays below a few milliseconds.
-    let mut nap = Duration::from_micros(200);
-    let status = loop {
-        match child.try_wait() {
-            Ok(Some(status)) => break status,
-            Ok(None) if t0.elapsed() > timeout => {
-                let _ = child.kill();
-                let _ = child.wait();
-                return Err(format!(
-                    "timed out after {} s (killed)",
-                    timeout.as_secs_f64()
-                ));
-            }
-            Ok(None) => {
-                std::thread::sleep(nap);
-                nap = (nap * 2).min(Duration::from_millis(5));
-            }
-            Err(e) => return Err(format!("waiting for {:?}: {e}", cmd.get_program())),
-        }
-    };
-    let wall = t0.elapsed().as_secs_f64();
-    Ok(Finished {
-        status,
-        stdout: out.join().unwrap_or_default(),
-        stderr: err.join().unwrap_or_default(),
-        wall,
-    })
+    conemesh::compare::process::run_timed(cmd, timeout).map_err(|e| e.to_string())
 }
 
 /// One tool's numbers on one case, from `conemesh eval --json`.
