@@ -248,34 +248,44 @@ def sign_test_p(wins: int, losses: int) -> float:
 
 def paired(df):
     """Each configuration after the first against the first, per measure, over the (input,
-    seed) pairs where both ran: ``n``, ``mean_diff``, ``wins``, ``ties``, ``losses``,
-    ``p_sign`` (as ``compare.json``'s ``paired``, without the bootstrap interval)."""
+    seed) pairs where both ran: ``n``, ``mean_diff``, ``ci_low``, ``ci_high`` (the 95 %
+    bootstrap interval), ``wins``, ``ties``, ``losses``, ``p_sign`` and ``significant``, as
+    ``compare.json``'s ``paired`` (computed by the same code, with the same streams)."""
+    import json
+
     import pandas as pd
+
+    from . import _conemesh
 
     configs = list(dict.fromkeys(df["config"]))
     ok = df[df["status"] == "ok"]
     base = ok[ok["config"] == configs[0]]
     rows = []
-    for key, better, _ in MEASURES:
-        for c in configs[1:]:
+    for mi, (key, better, _) in enumerate(MEASURES):
+        for ci, c in enumerate(configs[1:], start=1):
             other = ok[ok["config"] == c]
             both = other.merge(base, on=["mesh", "seed"], suffixes=("", "_base"), sort=False)
-            diffs = [float(a) - float(b) for a, b in zip(both[key], both[f"{key}_base"])]
-            signed = [d if better == "higher" else -d for d in diffs]
-            w = sum(d > 0 for d in signed)
-            t = sum(d == 0 for d in signed)
-            losses = sum(d < 0 for d in signed)
+            pairs = [
+                (float(b), float(a))
+                for a, b in zip(both[key], both[f"{key}_base"])
+                if not (math.isnan(float(a)) or math.isnan(float(b)))
+            ]
+            st = json.loads(_conemesh.paired_stats(pairs, better == "higher", ci, mi))
+            lo, hi = st["ci"] if st["ci"] is not None else (math.nan, math.nan)
             rows.append(
                 {
                     "measure": key,
                     "config": c,
                     "against": configs[0],
-                    "n": len(diffs),
-                    "mean_diff": sum(diffs) / len(diffs) if diffs else math.nan,
-                    "wins": w,
-                    "ties": t,
-                    "losses": losses,
-                    "p_sign": sign_test_p(w, losses),
+                    "n": st["n"],
+                    "mean_diff": st["mean_diff"],
+                    "ci_low": lo,
+                    "ci_high": hi,
+                    "wins": st["wins"],
+                    "ties": st["ties"],
+                    "losses": st["losses"],
+                    "p_sign": st["p_sign"],
+                    "significant": st["significant"],
                 }
             )
     return pd.DataFrame(rows)

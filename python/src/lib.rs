@@ -727,10 +727,7 @@ fn render<'py>(
     };
     let img = py.detach(|| {
         let sources = Sources {
-            metric: metric.as_ref().map(|(m, on_mesh)| match on_mesh {
-                true => VertexMetric::OnMesh(m),
-                false => VertexMetric::OnReference(m),
-            }),
+            metric: (metric.as_ref()).map(|(m, on_mesh)| VertexMetric::new(m, *on_mesh)),
             reference: reference.as_ref(),
             patches: patches.as_deref(),
             ..Default::default()
@@ -750,9 +747,30 @@ fn render<'py>(
     Ok(arr.into_pyarray(py))
 }
 
+/// `conemesh compare`'s statistics of configuration `config` (grid index, the first being 0)
+/// against the first on measure `measure` (index in its measure list), over `(first, other)`
+/// pairs: the same bootstrap stream, interval and sign test as the CLI's `compare.json`.
+#[pyfunction]
+fn paired_stats(
+    pairs: Vec<(f64, f64)>,
+    higher_is_better: bool,
+    config: usize,
+    measure: usize,
+) -> PyResult<String> {
+    use conemesh::compare::stats::{paired, Better};
+    let better = match higher_is_better {
+        true => Better::Higher,
+        false => Better::Lower,
+    };
+    let seed = conemesh::compare::paired_seed(config, measure);
+    serde_json::to_string(&paired(&pairs, better, seed))
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))
+}
+
 #[pymodule]
 fn _conemesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(paired_stats, m)?)?;
     m.add_function(wrap_pyfunction!(write, m)?)?;
     m.add_function(wrap_pyfunction!(remesh_options, m)?)?;
     m.add_function(wrap_pyfunction!(check_remesh_args, m)?)?;

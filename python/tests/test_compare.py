@@ -1,6 +1,6 @@
 """conemesh.compare on a local Dask cluster gives the same table as ``conemesh compare`` for
 the same grid: the same runs, output bytes, measures, per-input mean ± sd and paired
-counts and sign-test p-values; failures are rows; bad seeds are refused."""
+counts, bootstrap intervals and sign-test p-values; failures are rows; bad seeds are refused."""
 
 from __future__ import annotations
 
@@ -92,6 +92,12 @@ def test_python_summary_and_paired_are_the_cli_tables(both):
         ), key
         assert row["p_sign"] == pytest.approx(cli_row["p_sign"], rel=1e-12)
         assert row["mean_diff"] == pytest.approx(cli_row["mean_diff"], rel=1e-9, abs=1e-12)
+        # The same bootstrap stream over the same pairs in the same order: the same interval.
+        assert cli_row["ci"] is not None, key
+        assert (row["ci_low"], row["ci_high"]) == pytest.approx(
+            tuple(cli_row["ci"]), rel=1e-9, abs=1e-12
+        ), key
+        assert row["significant"] == cli_row["significant"], key
 
 
 def test_sign_test_is_exact():

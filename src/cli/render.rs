@@ -98,10 +98,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         (None, _) => None,
     };
     let sources = Sources {
-        metric: metric.as_ref().map(|(m, on_mesh)| match on_mesh {
-            true => VertexMetric::OnMesh(m),
-            false => VertexMetric::OnReference(m),
-        }),
+        metric: (metric.as_ref()).map(|(m, on_mesh)| VertexMetric::new(m, *on_mesh)),
         reference: reference.as_ref(),
         patches: patches.as_deref(),
         ..Default::default()

@@ -92,6 +92,14 @@ pub enum CompareError {
     Plot(#[from] crate::report::ReportError),
 }
 
+/// The bootstrap stream of configuration `config` (its index in the grid, the first being 0)
+/// against the first on measure `measure` (its index in [`measures::MEASURES`]): one fixed
+/// stream per pair, so the same pairs give the same interval in every run and in the Python
+/// front end's table.
+pub fn paired_seed(config: usize, measure: usize) -> u64 {
+    stats::BOOTSTRAP_SEED + (config * MEASURES.len() + measure) as u64
+}
+
 /// Mean and sample standard deviation over the seeds.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct MeanSd {
@@ -198,9 +206,7 @@ impl Comparison {
                             Some((value(b, m.key)?, value(r, m.key)?))
                         })
                         .collect();
-                    // One fixed stream per (measure, configuration): the same pairs give the
-                    // same interval in every run and in the Python front end's table.
-                    let seed = stats::BOOTSTRAP_SEED + (ci * MEASURES.len() + mi) as u64;
+                    let seed = paired_seed(ci, mi);
                     paired.push(PairedRow {
                         measure: m.key.to_string(),
                         config: c.name.clone(),

@@ -4,7 +4,7 @@
 //! picture embedded (data URIs: it opens from anywhere, with no network).
 
 use super::measures::{Measure, MEASURES};
-use super::{CompareError, Comparison, Status};
+use super::{CompareError, Comparison, Status, SummaryRow};
 use crate::quality::QualityStats;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -121,6 +121,26 @@ fn pool(stats: &[&QualityStats]) -> Option<QualityStats> {
     Some(p)
 }
 
+/// A p-value to three decimals, "< 0.001" below what three decimals show.
+fn p_value(p: f64) -> String {
+    match p < 0.0005 {
+        true => "< 0.001".to_string(),
+        false => format!("{p:.3}"),
+    }
+}
+
+/// Each measure of a summary row as "mean ± sd" ("-" where no run gave it), in [`MEASURES`]'
+/// order.
+fn mean_sd_cells(row: &SummaryRow) -> Vec<String> {
+    (MEASURES.iter())
+        .map(|m| {
+            row.measures.get(m.key).map_or("-".to_string(), |v| {
+                format!("{} ± {}", fmt(m, v.mean), fmt(m, v.sd))
+            })
+        })
+        .collect()
+}
+
 fn fmt(m: &Measure, x: f64) -> String {
     format!("{x:.*}", m.digits)
 }
@@ -164,10 +184,7 @@ pub fn markdown(c: &Comparison) -> String {
             row.ok,
             row.runs
         );
-        for m in &MEASURES {
-            let v = row.measures.get(m.key).map_or("-".to_string(), |v| {
-                format!("{} ± {}", fmt(m, v.mean), fmt(m, v.sd))
-            });
+        for v in mean_sd_cells(row) {
             let _ = write!(line, " {v} |");
         }
         let _ = writeln!(s, "{line}");
@@ -199,11 +216,11 @@ pub fn markdown(c: &Comparison) -> String {
             };
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {b0}{diff}{b1} | {ci} | {b0}{:.3}{b1} | {}/{}/{} |",
+                "| {} | {} | {} | {b0}{diff}{b1} | {ci} | {b0}{}{b1} | {}/{}/{} |",
                 m.label,
                 cell(&p.config),
                 st.n,
-                st.p_sign,
+                p_value(st.p_sign),
                 st.wins,
                 st.ties,
                 st.losses
@@ -280,10 +297,7 @@ pub fn html(c: &Comparison, dir: &Path) -> String {
             row.ok,
             row.runs
         );
-        for m in &MEASURES {
-            let v = row.measures.get(m.key).map_or("-".to_string(), |v| {
-                format!("{} ± {}", fmt(m, v.mean), fmt(m, v.sd))
-            });
+        for v in mean_sd_cells(row) {
             let _ = write!(s, "<td>{v}</td>");
         }
         s.push_str("</tr>\n");
@@ -313,13 +327,13 @@ fn html_paired(s: &mut String, c: &Comparison) {
             });
             let _ = writeln!(
                 s,
-                "<tr{}><td>{}</td><td>{}</td><td>{}</td><td>{:+.d$}</td><td>{ci}</td><td>{:.3}</td><td>{}/{}/{}</td></tr>",
+                "<tr{}><td>{}</td><td>{}</td><td>{}</td><td>{:+.d$}</td><td>{ci}</td><td>{}</td><td>{}/{}/{}</td></tr>",
                 if st.significant { " class=\"sig\"" } else { "" },
                 esc(m.label),
                 esc(&p.config),
                 st.n,
                 st.mean_diff,
-                st.p_sign,
+                p_value(st.p_sign),
                 st.wins,
                 st.ties,
                 st.losses
@@ -450,5 +464,13 @@ mod tests {
         ] {
             assert_eq!(super::base64(a.as_bytes()), b);
         }
+    }
+
+    #[test]
+    fn p_values_below_three_decimals_are_not_printed_as_zero() {
+        assert_eq!(super::p_value(2.0 / 2f64.powi(36)), "< 0.001");
+        assert_eq!(super::p_value(0.0005), "0.001");
+        assert_eq!(super::p_value(0.125), "0.125");
+        assert_eq!(super::p_value(1.0), "1.000");
     }
 }

@@ -72,6 +72,16 @@ pub enum VertexMetric<'a> {
     OnReference(&'a [Matrix3<f64>]),
 }
 
+impl<'a> VertexMetric<'a> {
+    /// `tensors` on the mesh drawn (`on_mesh`) or on the reference surface.
+    pub fn new(tensors: &'a [Matrix3<f64>], on_mesh: bool) -> Self {
+        match on_mesh {
+            true => VertexMetric::OnMesh(tensors),
+            false => VertexMetric::OnReference(tensors),
+        }
+    }
+}
+
 /// The data a colouring may need, besides the mesh.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Sources<'a> {
