@@ -48,7 +48,6 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    return_freed_memory();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Bench(a) => cli::bench::run(a),
@@ -68,19 +67,5 @@ fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             ExitCode::from(2)
         }
-    }
-}
-
-/// glibc's malloc keeps freed memory resident: blocks of up to 32 MiB come from its heaps, one
-/// arena per thread, and are only given back from the top of a heap. A large run frees much of
-/// what the setup and each region built (bumpy-l7: 525 MiB peak resident for a 315 MiB heap
-/// peak); blocks of 128 KiB and more mapped on their own, and a heap trimmed at every free,
-/// give it back (444 MiB).
-fn return_freed_memory() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: mallopt only sets allocator parameters, before any other thread exists.
-    unsafe {
-        libc::mallopt(libc::M_MMAP_THRESHOLD, 128 * 1024);
-        libc::mallopt(libc::M_TRIM_THRESHOLD, 0);
     }
 }
