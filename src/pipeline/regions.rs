@@ -708,6 +708,12 @@ fn merge(state: &mut LoopState, region_of: &[u32], runs: Vec<RegionRun>) -> Vec<
         }
         let mut on_cut = Vec::new();
         for (l, &v) in map.iter().enumerate().take(n0) {
+            // The region's passes may have moved a vertex it shares with no other region (its
+            // cut vertices are frozen, so this writes them back unchanged): its faces were
+            // certified at the new place.
+            w.mesh.positions[v.idx()] = rs.work.mesh.positions[l];
+            w.locations[v.idx()] = rs.work.locations[l];
+            w.curve[v.idx()] = rs.work.curve.get(l).copied().flatten();
             state.factors.raise(v, rs.factors.get(VertexId::new(l)));
             if region.cut.vertices[l] {
                 on_cut.push(v);
