@@ -906,4 +906,61 @@ mod tests {
             assert!(after.iter().any(|r| *r != u32::MAX));
         }
     }
+
+    /// The merge writes back where a region moved the vertices it shares with no other
+    /// region (its faces were certified there), and keeps its cut vertices where they were.
+    #[test]
+    fn merge_keeps_the_moves_a_region_made() {
+        let mesh = generators::plate(1.0, 4);
+        let topo = Topology::build(&mesh);
+        let n = mesh.n_vertices();
+        let mut whole = LoopState::from_parts(
+            WorkingMesh::from_reference(&mesh),
+            topo.clone(),
+            crate::features::FeatureLines::default(),
+            vec![false; n],
+            vec![1.0; n],
+        );
+        // Region 0 is the left half; the right half is in no region and stays as it is.
+        let region_of: Vec<u32> = (mesh.faces())
+            .map(|f| {
+                let [a, b, c] = mesh.face_points(f);
+                match (a.x + b.x + c.x) / 3.0 < 0.5 {
+                    true => 0,
+                    false => u32::MAX,
+                }
+            })
+            .collect();
+        let faces: Vec<FaceId> = mesh.faces().filter(|f| region_of[f.idx()] == 0).collect();
+        let region = extract(&whole.work, &topo, &region_of, 0, &faces);
+        let nl = region.whole.len();
+        let mut rs = LoopState::from_parts(
+            region.work.clone(),
+            Topology::build(&region.work.mesh),
+            crate::features::FeatureLines::default(),
+            vec![false; nl],
+            vec![1.0; nl],
+        );
+        let inner = (0..nl)
+            .find(|&l| {
+                let p = region.work.mesh.positions[l];
+                !region.cut.vertices[l] && p.x > 0.0 && p.y > 0.0 && p.y < 1.0
+            })
+            .expect("a vertex inside the region");
+        let cut = (0..nl)
+            .find(|&l| region.cut.vertices[l])
+            .expect("a cut vertex");
+        let moved = rs.work.mesh.positions[inner] + nalgebra::Vector3::new(0.01, 0.02, 0.0);
+        rs.work.mesh.positions[inner] = moved;
+        let (v_inner, v_cut) = (region.whole[inner], region.whole[cut]);
+        let cut_before = whole.work.mesh.positions[v_cut.idx()];
+        merge(
+            &mut whole,
+            &region_of,
+            vec![RegionRun { region, state: rs }],
+        );
+        assert_eq!(whole.work.mesh.positions[v_inner.idx()], moved);
+        assert_eq!(whole.work.mesh.positions[v_cut.idx()], cut_before);
+        assert_eq!(whole.work.mesh.n_faces(), mesh.n_faces());
+    }
 }
