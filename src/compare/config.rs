@@ -298,8 +298,8 @@ mod tests {
 
     #[test]
     fn seeds_parse_ranges_and_lists_and_refuse_empty_ranges() {
-        assert_eq!(parse_seeds("1-5").unwrap(), vec![1, 2, 3, 4, 5]);
-        assert_eq!(parse_seeds("7,1-2,2").unwrap(), vec![1, 2, 7]);
+        assert_eq!(parse_seeds("1-5").expect("a range"), vec![1, 2, 3, 4, 5]);
+        assert_eq!(parse_seeds("7,1-2,2").expect("a list"), vec![1, 2, 7]);
         let e = parse_seeds("5-1").unwrap_err().to_string();
         assert!(e.contains("5-1") && e.contains("empty"), "{e}");
         assert!(parse_seeds("a-3").is_err());
@@ -308,18 +308,22 @@ mod tests {
 
     #[test]
     fn configurations_parse_names_and_quoted_arguments() {
-        let c = Config::parse("kring=--strategy kring --strategy-opt 'rings=4'").unwrap();
+        let c =
+            Config::parse("kring=--strategy kring --strategy-opt 'rings=4'").expect("quoted args");
         assert_eq!(c.name, "kring");
         assert_eq!(c.args, ["--strategy", "kring", "--strategy-opt", "rings=4"]);
-        assert_eq!(Config::parse("base=").unwrap().args, Vec::<String>::new());
+        assert_eq!(
+            Config::parse("base=").expect("no args").args,
+            Vec::<String>::new()
+        );
         assert!(Config::parse("noequals").is_err());
         assert!(Config::parse("a/b=--sweeps 2").is_err());
         let own = Config::parse("x=--seed 3").unwrap_err().to_string();
         assert!(own.contains("--seed"), "{own}");
         assert!(split_args("'open").is_err());
         let twice = [
-            Config::parse("a=").unwrap(),
-            Config::parse("a=--sweeps 1").unwrap(),
+            Config::parse("a=").expect("no args"),
+            Config::parse("a=--sweeps 1").expect("one option"),
         ];
         assert!(check_configs(&twice).is_err());
         assert!(check_configs(&[]).is_err());

@@ -209,12 +209,20 @@ impl Grid {
                 });
             }
         });
-        // A worker's panic is re-raised by `scope` above, so every slot is filled here.
+        // A worker's panic is re-raised by `scope` above, so every slot is filled here; an
+        // empty one is still an error, not a panic.
         records
             .into_inner()
             .unwrap_or_else(|poisoned| poisoned.into_inner())
             .into_iter()
-            .map(|r| r.expect("every job ran"))
+            .map(|r| {
+                r.unwrap_or_else(|| {
+                    Err(super::CompareError::Os {
+                        path: dir.display().to_string(),
+                        source: std::io::Error::other("a run of the grid was never recorded"),
+                    })
+                })
+            })
             .collect()
     }
 

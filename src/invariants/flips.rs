@@ -21,7 +21,7 @@ use std::sync::Arc;
 /// strictly negative = flipped: a float decision on normals, not an exact predicate. Zero-area
 /// faces (zero normal) are never reported here (the degenerate-face certificate catches them).
 pub struct FlipTest {
-    proj: Arc<SurfaceProjector>,
+    proj: SurfaceProjector,
     input: Arc<TriMesh>,
     /// The faces around each input vertex: those of `v` are
     /// `vertex_faces[vertex_start[v]..vertex_start[v + 1]]` (one allocation, not one per vertex).
@@ -32,15 +32,12 @@ pub struct FlipTest {
 impl FlipTest {
     /// Index the input surface.
     pub fn new(input: &TriMesh) -> FlipTest {
-        FlipTest::with_index(
-            Arc::new(input.clone()),
-            Arc::new(SurfaceProjector::new(input)),
-        )
+        FlipTest::with_index(Arc::new(input.clone()), SurfaceProjector::new(input))
     }
 
     /// The test against `input`, sharing it and its closest-point index `proj` (a metric
     /// field's, say) instead of copying them.
-    pub fn with_index(input: Arc<TriMesh>, proj: Arc<SurfaceProjector>) -> FlipTest {
+    pub fn with_index(input: Arc<TriMesh>, proj: SurfaceProjector) -> FlipTest {
         let mut vertex_start = vec![0u32; input.n_vertices() + 1];
         for t in &input.triangles {
             for v in t {

@@ -8,10 +8,12 @@ use nalgebra::Point3;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::TriMesh as PTriMesh;
+use std::sync::Arc;
 
 /// Closest-point queries on a triangle mesh (parry BVH + point-triangle projection).
+#[derive(Clone)]
 pub struct SurfaceProjector {
-    bvh: Option<PTriMesh>,
+    bvh: Option<Arc<PTriMesh>>,
 }
 
 impl SurfaceProjector {
@@ -20,22 +22,13 @@ impl SurfaceProjector {
     pub fn new(mesh: &TriMesh) -> Self {
         let indices: Vec<[u32; 3]> = mesh.index_triangles();
         SurfaceProjector {
-            bvh: parry_trimesh(&mesh.positions, indices),
+            bvh: parry_trimesh(&mesh.positions, indices).map(Arc::new),
         }
     }
 
-    /// Index the triangles of `mesh`, which must have some; parry's refusal as text.
-    pub fn try_new(mesh: &TriMesh) -> Result<Self, String> {
-        let vertices: Vec<PVec> = (mesh.positions.iter())
-            .map(|p| PVec::new(p.x, p.y, p.z))
-            .collect();
-        let bvh = PTriMesh::new(vertices, mesh.index_triangles()).map_err(|e| e.to_string())?;
-        Ok(SurfaceProjector { bvh: Some(bvh) })
-    }
-
-    /// parry's triangle mesh and BVH (`None` for a mesh without faces).
-    pub fn parry(&self) -> Option<&PTriMesh> {
-        self.bvh.as_ref()
+    /// Queries on an index built already (a metric field's), sharing it.
+    pub fn sharing(bvh: Arc<PTriMesh>) -> Self {
+        SurfaceProjector { bvh: Some(bvh) }
     }
 
     /// The closest point of the surface to `p`, the face it lies on, and the distance.

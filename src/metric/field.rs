@@ -9,6 +9,7 @@ use crate::mesh::{SurfaceLocation, SurfaceProjector, TriMesh};
 use nalgebra::{Matrix2, Matrix3, Point3, Vector3};
 use parry3d_f64::math::Vector as PVector;
 use parry3d_f64::query::PointQueryWithLocation;
+use parry3d_f64::shape::TriMesh as ParryTriMesh;
 use std::sync::Arc;
 
 /// Relative tolerance of the symmetry and positive-semi-definiteness checks of
@@ -29,7 +30,7 @@ pub struct MetricField {
     reference: Arc<TriMesh>,
     metrics: Vec<Matrix3<f64>>,
     face_normals: Arc<Vec<Vector3<f64>>>,
-    projector: Arc<SurfaceProjector>,
+    bvh: Arc<ParryTriMesh>,
 }
 
 impl std::fmt::Debug for MetricField {
@@ -177,8 +178,13 @@ impl MetricField {
     pub fn new(reference: TriMesh, vertex_metrics: Vec<Matrix3<f64>>) -> Result<Self, MetricError> {
         reference.validate()?;
         let metrics = checked_metrics(&reference, vertex_metrics)?;
-        let projector =
-            SurfaceProjector::try_new(&reference).map_err(|detail| MetricError::Bvh { detail })?;
+        let bvh = ParryTriMesh::new(
+            reference.positions.iter().map(to_parry).collect(),
+            reference.index_triangles(),
+        )
+        .map_err(|e| MetricError::Bvh {
+            detail: e.to_string(),
+        })?;
         let face_normals = reference
             .faces()
             .map(|f| reference.face_normal(f))
@@ -187,7 +193,7 @@ impl MetricField {
             reference: Arc::new(reference),
             metrics,
             face_normals: Arc::new(face_normals),
-            projector: Arc::new(projector),
+            bvh: Arc::new(bvh),
         })
     }
 
@@ -206,7 +212,7 @@ impl MetricField {
             reference: Arc::clone(&self.reference),
             metrics: Vec::new(),
             face_normals: Arc::clone(&self.face_normals),
-            projector: Arc::clone(&self.projector),
+            bvh: Arc::clone(&self.bvh),
         }
     }
 
@@ -257,9 +263,14 @@ impl MetricField {
         &self.reference
     }
 
-    /// The closest-point index of the reference surface, shared.
-    pub fn projector(&self) -> &Arc<SurfaceProjector> {
-        &self.projector
+    /// Closest-point queries on the reference surface, sharing this field's BVH.
+    pub fn projector(&self) -> SurfaceProjector {
+        SurfaceProjector::sharing(Arc::clone(&self.bvh))
+    }
+
+    /// This field and `other` share one reference and one BVH.
+    pub fn shares_index_with(&self, other: &MetricField) -> bool {
+        Arc::ptr_eq(&self.reference, &other.reference) && Arc::ptr_eq(&self.bvh, &other.bvh)
     }
 
     /// The tensor of every reference vertex, in vertex order.
@@ -271,11 +282,7 @@ impl MetricField {
     /// via parry's BVH), as a location (face + barycentric coordinates clamped to the face,
     /// summing to 1) and its position. A non-finite `p` yields a corner of face `f0`.
     pub fn project(&self, p: &Point3<f64>) -> (SurfaceLocation, Point3<f64>) {
-        let bvh = self
-            .projector
-            .parry()
-            .expect("a field's reference has faces");
-        let (proj, (tri, _)) = bvh.project_local_point_and_get_location(to_parry(p), false);
+        let (proj, (tri, _)) = (self.bvh).project_local_point_and_get_location(to_parry(p), false);
         let face = if (tri as usize) < self.reference.n_faces() {
             FaceId(tri)
         } else {
@@ -291,11 +298,8 @@ impl MetricField {
     /// BVH), ascending. Used to find the part of the reference surface under a patch.
     pub fn faces_in_box(&self, lo: &Point3<f64>, hi: &Point3<f64>) -> Vec<FaceId> {
         let aabb = parry3d_f64::bounding_volume::Aabb::new(to_parry(lo), to_parry(hi));
-        let bvh = self
-            .projector
-            .parry()
-            .expect("a field's reference has faces");
-        let mut faces: Vec<FaceId> = bvh
+        let mut faces: Vec<FaceId> = self
+            .bvh
             .bvh()
             .intersect_aabb(&aabb)
             .filter(|&f| (f as usize) < self.reference.n_faces())
@@ -362,11 +366,7 @@ mod tests {
         let scaled = field
             .with_metrics(vec![Matrix3::identity() * 4.0; n])
             .expect("scaled identity");
-        assert!(Arc::ptr_eq(field.projector(), scaled.projector()));
-        assert!(Arc::ptr_eq(
-            field.shared_reference(),
-            scaled.shared_reference()
-        ));
+        assert!(field.shares_index_with(&scaled));
         assert_eq!(scaled.vertex_metrics()[0], Matrix3::identity() * 4.0);
         assert_eq!(field.vertex_metrics()[0], Matrix3::identity());
         let p = Point3::new(0.3, 0.2, 2.0);

@@ -117,7 +117,7 @@ impl<'a> RunContext<'a> {
             improvers: &stages.improvers,
             flip_test: Arc::new(FlipTest::with_index(
                 Arc::clone(field.shared_reference()),
-                Arc::clone(field.projector()),
+                field.projector(),
             )),
             ref_normals: Arc::new(reference.area_weighted_normals()),
             input_pairs,
