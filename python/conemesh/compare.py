@@ -20,6 +20,7 @@ import sys
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
+from . import _conemesh
 from . import batch as _batch
 
 #: The measures of ``conemesh compare`` (``src/compare/measures.rs``): key, which way is
@@ -44,17 +45,9 @@ COLUMNS = ("config", "mesh", "seed", "status", "error", "output", "output_sha256
     m[0] for m in MEASURES
 )
 
-#: The arguments compare sets for every run (as ``conemesh compare`` refuses them).
-OWN_ARGS = (
-    "-o",
-    "--output",
-    "--report",
-    "--write-metric",
-    "--seed",
-    "-q",
-    "--quiet",
-    "--debug-dir",
-)
+#: The arguments compare sets for every run (as ``conemesh compare`` refuses them): the
+#: library's list.
+OWN_ARGS = tuple(_conemesh.compare_own_args())
 
 
 def _configs(configs) -> list[tuple[str, list[str]]]:
@@ -160,8 +153,6 @@ def compare(
     """
     import pandas as pd
 
-    from . import _conemesh
-
     cfgs = _configs(configs)
     for name, args in cfgs:
         try:
@@ -254,8 +245,6 @@ def paired(df):
     import json
 
     import pandas as pd
-
-    from . import _conemesh
 
     configs = list(dict.fromkeys(df["config"]))
     ok = df[df["status"] == "ok"]

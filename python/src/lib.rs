@@ -747,6 +747,13 @@ fn render<'py>(
     Ok(arr.into_pyarray(py))
 }
 
+/// The `conemesh remesh` arguments `conemesh compare` sets for every run (a configuration may
+/// not set them), from the library's one list.
+#[pyfunction]
+fn compare_own_args() -> Vec<&'static str> {
+    conemesh::compare::config::OWN_ARGS.to_vec()
+}
+
 /// `conemesh compare`'s statistics of configuration `config` (grid index, the first being 0)
 /// against the first on measure `measure` (index in its measure list), over `(first, other)`
 /// pairs: the same bootstrap stream, interval and sign test as the CLI's `compare.json`.
@@ -771,6 +778,7 @@ fn paired_stats(
 fn _conemesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(paired_stats, m)?)?;
+    m.add_function(wrap_pyfunction!(compare_own_args, m)?)?;
     m.add_function(wrap_pyfunction!(write, m)?)?;
     m.add_function(wrap_pyfunction!(remesh_options, m)?)?;
     m.add_function(wrap_pyfunction!(check_remesh_args, m)?)?;
