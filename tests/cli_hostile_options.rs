@@ -295,3 +295,36 @@ fn output_paths_that_are_not_utf8_are_written_and_reported_lossily() {
     let written = json["output"].as_str().expect("a string");
     assert!(written.ends_with("out-\u{fffd}.obj"), "{written}");
 }
+
+#[test]
+fn a_disk_read_as_one_polygon_of_100000_corners_is_refused_by_name_with_no_output() {
+    // Issue 35's hostile disk: the centre first, then the circle. Its triangulation is the fan
+    // of 99,998 slivers around the centre; the remesh refuses it by the centre's id, before
+    // computing the metric, and writes nothing.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let input = dir.path().join("disk.obj");
+    let n = 100_000;
+    let mut text = String::from("v 0 0 0\n");
+    for i in 0..n - 1 {
+        let a = std::f64::consts::TAU * i as f64 / (n - 1) as f64;
+        text += &format!("v {} {} 0\n", a.cos(), a.sin());
+    }
+    text += "f";
+    for i in 1..=n {
+        text += &format!(" {i}");
+    }
+    text += "\n";
+    std::fs::write(&input, text).expect("write");
+    let out = dir.path().join("out.obj");
+    let report = dir.path().join("out.json");
+    let o = conemesh(&[
+        "remesh",
+        input.to_str().expect("utf-8"),
+        "-o",
+        out.to_str().expect("utf-8"),
+        "--report",
+        report.to_str().expect("utf-8"),
+    ]);
+    refused(&o, "input vertex v0 is a corner of 99998 faces (at most 16384)");
+    assert!(!out.exists() && !report.exists());
+}

@@ -59,7 +59,7 @@ pub use records::{
 pub use regions::{
     partition, BAND_RINGS, CUT_QUANTILE, DEFAULT_REGION_FACES, MAX_CUT_EDGE, MIN_FACE_WEIGHT,
 };
-pub use remesher::{Remeshed, Remesher};
+pub use remesher::{Remeshed, Remesher, MAX_FACES_AT_VERTEX};
 pub use sizing::{
     coarse_input_estimate, expected_faces, Plan, MAX_EXPECTED_FACES, MIN_PATCH_FACE_CAP,
 };
