@@ -49,8 +49,11 @@ pub enum RegistryError {
         expected: &'static str,
     },
     /// An option not written `KEY=VALUE`.
-    #[error("option `{0}` is not of the form KEY=VALUE")]
-    Malformed(String),
+    #[error("option `{item}` is not of the form KEY=VALUE")]
+    Malformed {
+        /// the text given
+        item: String,
+    },
 }
 
 /// One option of a row: its name and what it means, with its default.
@@ -97,7 +100,9 @@ impl Params {
             let (k, v) = item
                 .split_once('=')
                 .filter(|(k, _)| !k.trim().is_empty())
-                .ok_or_else(|| RegistryError::Malformed(item.to_string()))?;
+                .ok_or_else(|| RegistryError::Malformed {
+                    item: item.to_string(),
+                })?;
             given.insert(k.trim().to_string(), v.trim().to_string());
         }
         Ok(Params { given })
@@ -261,11 +266,13 @@ mod tests {
         }
         assert_eq!(
             Params::parse(&["times"]),
-            Err(RegistryError::Malformed("times".into()))
+            Err(RegistryError::Malformed {
+                item: "times".into()
+            })
         );
         assert_eq!(
             Params::parse(&["=3"]),
-            Err(RegistryError::Malformed("=3".into()))
+            Err(RegistryError::Malformed { item: "=3".into() })
         );
     }
 }
