@@ -19,6 +19,7 @@
 //! - [`quality`], [`report`]: Sec. 4.1, the yardstick; JSON and plots.
 //! - [`render`]: pictures of a surface coloured by q, angle, patch or distance (Fig. 3, 6).
 //! - [`registry`], [`contract`]: the extension points' tables and their contract checks.
+//! - [`option_error`]: an option value no run can use, named with its value and range.
 //! - [`boundary`]: the input's boundary curves the output's boundary lies on (ours).
 //! - [`suite`]: the analytic benchmark cases (surfaces with user-style metrics).
 //! - [`compare`]: comparisons of configurations over inputs × seeds, their statistics and
@@ -38,6 +39,7 @@ pub mod io;
 pub mod lift;
 pub mod mesh;
 pub mod metric;
+pub mod option_error;
 pub mod param;
 pub mod patches;
 pub mod pipeline;

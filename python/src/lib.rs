@@ -695,7 +695,7 @@ fn render<'py>(
     };
     let color = raise(
         py,
-        ColorBy::parse(&color).map_err(|e| Failure::option(format!("color: {e}"))),
+        ColorBy::parse(&color).map_err(|e| Failure::option(e.to_string())),
     )?;
     let wireframe = raise(
         py,

@@ -140,11 +140,10 @@ impl Remesher {
     ) -> Result<Remeshed, PipelineError> {
         if let Some(m) = metric {
             if m.len() != input.n_vertices() {
-                return Err(PipelineError::Input(format!(
-                    "the metric has {} tensors for {} vertices",
-                    m.len(),
-                    input.n_vertices()
-                )));
+                return Err(PipelineError::MetricCount {
+                    tensors: m.len(),
+                    vertices: input.n_vertices(),
+                });
             }
         }
         certify_faces_at_vertices(input)?;
