@@ -11,6 +11,7 @@ mod medit;
 mod obj;
 mod off;
 mod outputs;
+pub mod paths;
 pub mod patches;
 mod ply;
 mod polygon;
