@@ -105,7 +105,7 @@ pub fn same_path(a: &Path, b: &Path) -> bool {
 )]
 pub struct CommitError {
     /// what failed (part of the message, not a `source()`, so that a chain prints it once)
-    pub error: IoError,
+    pub error: Box<IoError>,
     /// every destination of the transaction
     pub destinations: Vec<PathBuf>,
 }
@@ -118,10 +118,8 @@ pub fn commit(outputs: Outputs) -> Result<(), CommitError> {
         .iter()
         .map(|p| p.to_path_buf())
         .collect();
-    outputs
-        .commit()
-        .map_err(|error| CommitError {
-            error,
-            destinations,
-        })
+    outputs.commit().map_err(|error| CommitError {
+        error: Box::new(error),
+        destinations,
+    })
 }

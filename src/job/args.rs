@@ -34,6 +34,8 @@ pub enum Coarse {
 }
 
 /// Arguments of `conemesh remesh`.
+// The field docs are the flags' help text, where `[2]` is a default, not a link.
+#[allow(rustdoc::broken_intra_doc_links)]
 #[derive(clap::Args, Debug)]
 pub struct RemeshArgs {
     /// Input mesh (OBJ, OFF, PLY, STL, Medit .mesh). Without it, a built-in torus.

@@ -45,7 +45,7 @@ pub enum FilesError {
         path: PathBuf,
         /// why
         #[source]
-        source: IoError,
+        source: Box<IoError>,
     },
     /// The plots folder that cannot be staged.
     #[error("writing plots into {}", dir.display())]
@@ -54,7 +54,7 @@ pub enum FilesError {
         dir: PathBuf,
         /// why
         #[source]
-        source: IoError,
+        source: Box<IoError>,
     },
     /// A histogram that cannot be drawn or written.
     #[error("writing plots into {}", dir.display())]
@@ -136,10 +136,12 @@ impl OutputFiles {
 
 /// Stage `bytes` for `path`.
 fn stage_bytes(outputs: &mut Outputs, path: &Path, bytes: &[u8]) -> Result<(), FilesError> {
-    outputs.bytes(path, bytes).map_err(|source| FilesError::Write {
-        path: path.to_path_buf(),
-        source,
-    })
+    outputs
+        .bytes(path, bytes)
+        .map_err(|source| FilesError::Write {
+            path: path.to_path_buf(),
+            source: Box::new(source),
+        })
 }
 
 /// The files beside the mesh, staged into `outputs`: the metrics, the patches, `report` as
@@ -186,12 +188,10 @@ fn stage_plots(
         dir: dir.to_path_buf(),
         source,
     };
-    let staged = outputs
-        .dir(dir)
-        .map_err(|source| FilesError::PlotsFolder {
-            dir: dir.to_path_buf(),
-            source,
-        })?;
+    let staged = outputs.dir(dir).map_err(|source| FilesError::PlotsFolder {
+        dir: dir.to_path_buf(),
+        source: Box::new(source),
+    })?;
     crate::report::write_quality_plots(
         &staged,
         short_name,

@@ -273,7 +273,7 @@ impl Outcome {
                 .mesh(p, &self.remeshed.mesh, &read, &write)
                 .map_err(|source| FilesError::Write {
                     path: p.clone(),
-                    source,
+                    source: Box::new(source),
                 })?;
         }
         let report = self.report(source, files.mesh.as_deref());
@@ -296,4 +296,163 @@ pub fn peak_rss_mib() -> Option<f64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb / 1024.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::paths::OutputPathError;
+    use clap::Parser;
+    use std::path::PathBuf;
+
+    type R = Result<(), Box<dyn std::error::Error>>;
+
+    /// `conemesh remesh FLAGS` as the front ends parse it.
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: RemeshArgs,
+    }
+
+    fn args(flags: &[&str]) -> Result<RemeshArgs, clap::Error> {
+        let argv = std::iter::once("remesh").chain(flags.iter().copied());
+        Ok(Cli::try_parse_from(argv)?.args)
+    }
+
+    /// A small torus with every third face reversed: an oriented manifold only after a repair.
+    fn shuffled_torus() -> TriMesh {
+        let mut m = crate::mesh::generators::torus(1.0, 0.4, 16, 8);
+        for (f, t) in m.triangles.iter_mut().enumerate() {
+            if f % 3 == 2 {
+                t.swap(0, 1);
+            }
+        }
+        m
+    }
+
+    #[test]
+    fn a_repair_job_orients_the_input_scores_the_output_and_reports_both() -> R {
+        let job = args(&["--repair", "-q", "--improvers", "none"])?.job(false)?;
+        let outcome = job.run(JobInput::new(shuffled_torus(), None), |_| {})?;
+        let log = outcome.repair.as_ref().ok_or("a repair log")?;
+        assert!(!log.flipped_faces.is_empty());
+        let topo = crate::Topology::build(&outcome.input);
+        crate::invariants::certify_oriented(&outcome.input, &topo)?;
+        assert_eq!(outcome.eval.output.faces, outcome.remeshed.mesh.n_faces());
+        assert_eq!(outcome.eval.input.faces, outcome.input.n_faces());
+
+        let file = Source::File {
+            name: "t.off".into(),
+            short_name: "t".into(),
+            polygons_triangulated: 3,
+        };
+        let doc = outcome.report(&file, Some(Path::new("out.obj")));
+        assert_eq!(doc["input"], "t.off");
+        assert_eq!(doc["output"], "out.obj");
+        assert_eq!(doc["polygons_triangulated"], 3);
+        let flipped = doc["repair"]["flipped_faces"].as_array().map(Vec::len);
+        assert_eq!(flipped, Some(log.flipped_faces.len()));
+        assert!(doc.get("table_row").is_none());
+        let arrays = outcome.report(&Source::Arrays, None);
+        assert!(arrays["input"].is_null() && arrays["output"].is_null());
+        assert!(arrays.get("polygons_triangulated").is_none());
+        assert_eq!(arrays["table_row"], outcome.eval.table_row("remesh"));
+        Ok(())
+    }
+
+    #[test]
+    fn without_a_repair_the_shuffled_input_is_refused_by_algorithm_1() -> R {
+        let job = args(&["-q"])?.job(false)?;
+        let refused = job.run(JobInput::new(shuffled_torus(), None), |_| {});
+        assert!(matches!(refused, Err(JobError::Remesh(_))));
+        Ok(())
+    }
+
+    #[test]
+    fn output_paths_that_meet_are_refused_naming_both_flags() -> R {
+        let dir = tempfile::tempdir()?;
+        let report = dir.path().join("r.json");
+        let files = OutputFiles {
+            report: Some(report.clone()),
+            metric: Some(report.clone()),
+            ..Default::default()
+        };
+        let e = files.check(&[]).err().ok_or("refused")?;
+        assert!(matches!(
+            e,
+            OutputPathError::SamePath {
+                flag: "--write-metric",
+                other: "--report",
+                ..
+            }
+        ));
+        let files = OutputFiles {
+            report: Some(report.clone()),
+            ..Default::default()
+        };
+        let e = files
+            .check(&[("the input", &report)])
+            .err()
+            .ok_or("refused")?;
+        assert!(matches!(
+            e,
+            OutputPathError::SamePath {
+                flag: "--report",
+                other: "the input",
+                ..
+            }
+        ));
+        let files = OutputFiles {
+            report: Some(report.clone()),
+            plots: Some(report),
+            ..Default::default()
+        };
+        let e = files.check(&[]).err().ok_or("refused")?;
+        assert!(matches!(
+            e,
+            OutputPathError::SamePath {
+                flag: "--plots",
+                other: "--report",
+                ..
+            }
+        ));
+        let missing = OutputFiles {
+            mesh: Some(PathBuf::from("/no/such/folder/out.obj")),
+            ..Default::default()
+        };
+        let e = missing.check(&[]).err().ok_or("refused")?;
+        assert!(matches!(e, OutputPathError::NoFolder { flag: "-o", .. }));
+        Ok(())
+    }
+
+    #[test]
+    fn improver_options_must_fit_the_improvers_that_run() -> R {
+        let e = args(&["--no-improve", "--improve-q", "0.7"])?
+            .job(false)
+            .err()
+            .ok_or("refused")?;
+        assert_eq!(
+            e,
+            ArgsError::ImproverNotRun {
+                flag: "--improve-q",
+                name: "eq5".into(),
+                running: crate::pipeline::DEFAULT_IMPROVERS
+                    .iter()
+                    .filter(|n| **n != "eq5")
+                    .map(|n| n.to_string())
+                    .collect(),
+            }
+        );
+        let e = args(&["--improver-opt", "eq5q=1"])?
+            .job(false)
+            .err()
+            .ok_or("refused")?;
+        assert_eq!(
+            e,
+            ArgsError::ImproverOptForm {
+                item: "eq5q=1".into()
+            }
+        );
+        Ok(())
+    }
 }
