@@ -158,7 +158,8 @@ fn all_outputs_as_one_transaction_remesh_undoes_the_mesh_when_the_last_plot_fail
         "--plots",
         &s("plots"),
         "--quiet",
-        "--no-improve",
+        "--improvers",
+        "surface",
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -188,7 +189,8 @@ fn all_outputs_as_one_transaction_remesh_undoes_the_mesh_when_the_last_plot_fail
         "--plots",
         &s("plots"),
         "--quiet",
-        "--no-improve",
+        "--improvers",
+        "surface",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let mesh = conemesh::io::read_mesh(&d("out.obj")).expect("new mesh");
@@ -279,7 +281,8 @@ fn output_paths_that_are_not_utf8_are_written_and_reported_lossily() {
             "-q",
             "--max-patches",
             "2",
-            "--no-improve",
+            "--improvers",
+            "surface",
             "-o",
         ])
         .arg(&out)
@@ -294,4 +297,40 @@ fn output_paths_that_are_not_utf8_are_written_and_reported_lossily() {
         serde_json::from_slice(&std::fs::read(&report).expect("report")).expect("json");
     let written = json["output"].as_str().expect("a string");
     assert!(written.ends_with("out-\u{fffd}.obj"), "{written}");
+}
+
+#[test]
+fn a_disk_read_as_one_polygon_of_100000_corners_is_refused_by_name_with_no_output() {
+    // Issue 35's hostile disk: the centre first, then the circle. Its triangulation is the fan
+    // of 99,998 slivers around the centre; the remesh refuses it by the centre's id, before
+    // computing the metric, and writes nothing.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let input = dir.path().join("disk.obj");
+    let n = 100_000;
+    let mut text = String::from("v 0 0 0\n");
+    for i in 0..n - 1 {
+        let a = std::f64::consts::TAU * i as f64 / (n - 1) as f64;
+        text += &format!("v {} {} 0\n", a.cos(), a.sin());
+    }
+    text += "f";
+    for i in 1..=n {
+        text += &format!(" {i}");
+    }
+    text += "\n";
+    std::fs::write(&input, text).expect("write");
+    let out = dir.path().join("out.obj");
+    let report = dir.path().join("out.json");
+    let o = conemesh(&[
+        "remesh",
+        input.to_str().expect("utf-8"),
+        "-o",
+        out.to_str().expect("utf-8"),
+        "--report",
+        report.to_str().expect("utf-8"),
+    ]);
+    refused(
+        &o,
+        "input vertex v0 is a corner of 99998 faces (at most 16384)",
+    );
+    assert!(!out.exists() && !report.exists());
 }

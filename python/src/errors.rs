@@ -241,6 +241,9 @@ pub fn from_pipeline(e: &PipelineError) -> Failure {
             ..from_metric(m)
         },
         PipelineError::Input(_) => Failure::input(msg),
+        PipelineError::CrowdedVertex { vertex, .. } => {
+            Failure::input(msg).with("vertices", Attr::Ints(vec![vertex.0 as i64]))
+        }
         // The piece's failure decides the class; its ids are the piece's own, so they are
         // in the message only, with the piece's place.
         PipelineError::Region {

@@ -427,20 +427,16 @@ mod tests {
 
     #[test]
     fn improver_options_must_fit_the_improvers_that_run() -> R {
-        let e = args(&["--no-improve", "--improve-q", "0.7"])?
+        let e = args(&["--improvers", "surface", "--improver-opt", "eq5.q=0.7"])?
             .job(false)
             .err()
             .ok_or("refused")?;
         assert_eq!(
             e,
             ArgsError::ImproverNotRun {
-                flag: "--improve-q",
+                item: "eq5.q=0.7".into(),
                 name: "eq5".into(),
-                running: crate::pipeline::DEFAULT_IMPROVERS
-                    .iter()
-                    .filter(|n| **n != "eq5")
-                    .map(|n| n.to_string())
-                    .collect(),
+                running: vec!["surface".into()],
             }
         );
         let e = args(&["--improver-opt", "eq5q=1"])?

@@ -199,6 +199,24 @@ pub enum PipelineError {
     /// Invalid input or options.
     #[error("{0}")]
     Input(String),
+    /// An input vertex is a corner of more faces than [`super::MAX_FACES_AT_VERTEX`]: the
+    /// patch around it would hold them all (they are slivers meeting there, e.g. a polygon of
+    /// that many corners cut into a fan), and a patch's parameterization, certificates and
+    /// projections cost more than linearly in such a fan. Refused before any work.
+    #[error(
+        "input vertex {vertex} is a corner of {faces} faces (at most {max}): the patch around it \
+         would hold them all, slivers meeting at one point, which conemesh cannot remesh in \
+         bounded time (a polygon of that many corners cut into a fan? triangulate it with \
+         interior points first)"
+    )]
+    CrowdedVertex {
+        /// the vertex (input numbering)
+        vertex: VertexId,
+        /// the faces it is a corner of
+        faces: usize,
+        /// the bound
+        max: usize,
+    },
     /// The run was stopped through [`super::Cancel`] (e.g. Ctrl-C in the Python package);
     /// nothing is returned.
     #[error("cancelled after {patches} patches")]

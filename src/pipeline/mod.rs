@@ -48,8 +48,9 @@ mod step;
 
 pub use error::{PipelineError, Stage, StageError};
 pub use options::{
-    default_improvers, Cancel, CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO,
-    DEFAULT_BATCH, DEFAULT_IMPROVERS, DENSE_INPUT_RATIO, FACE_BUDGET, WORK_BUDGET,
+    default_improver_names, default_improvers, Cancel, Choice, CoarseInput, Registries,
+    RemeshOptions, Stages, TargetLength, COARSE_RATIO, DEFAULT_BATCH, DENSE_INPUT_RATIO,
+    FACE_BUDGET, WORK_BUDGET,
 };
 pub use records::{
     AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,
@@ -59,7 +60,7 @@ pub use records::{
 pub use regions::{
     partition, BAND_RINGS, CUT_QUANTILE, DEFAULT_REGION_FACES, MAX_CUT_EDGE, MIN_FACE_WEIGHT,
 };
-pub use remesher::{Remeshed, Remesher};
+pub use remesher::{Remeshed, Remesher, MAX_FACES_AT_VERTEX};
 pub use sizing::{
     coarse_input_estimate, expected_faces, Plan, MAX_EXPECTED_FACES, MIN_PATCH_FACE_CAP,
 };

@@ -23,6 +23,13 @@ use crate::mesh::TriMesh;
 use crate::metric::{unit_target_metric, MetricError, MetricField, MetricOptions, Normalization};
 use nalgebra::Matrix3;
 
+/// The most faces one input vertex may be a corner of ([`PipelineError::CrowdedVertex`]).
+/// Scanned and CAD meshes stay far below it (a pole of a UV sphere, or the cap of a finely
+/// tessellated cylinder cut into a fan, has hundreds to a few thousand). The cost of a fan
+/// grows faster than its faces: one at this bound takes about half a minute, one of 100,000
+/// faces more than five.
+pub const MAX_FACES_AT_VERTEX: usize = 16_384;
+
 /// Algorithm 1 from a mesh in file units: [`Remesher::run`] drops unreferenced vertices,
 /// scales the input to unit bounding-box diagonal, builds the metric (the curvature metric
 /// of Sec. 3.1, or the user's), runs [`super::remesh`], maps the result back to file units
@@ -30,8 +37,8 @@ use nalgebra::Matrix3;
 pub struct Remesher {
     /// Options of Algorithm 1.
     pub options: RemeshOptions,
-    /// The extension points; `None`: the paper's methods, with the planar remesher set for
-    /// absolute sizes when a user metric is given ([`Stages::for_user_metric`]).
+    /// The extension points; `None`: the paper's methods, set for absolute sizes when a user
+    /// metric is given ([`Stages::for_sizes`]).
     pub stages: Option<Stages>,
     /// How the curvature metric is estimated (when no user metric is given).
     pub metric: MetricOptions,
@@ -142,6 +149,7 @@ impl Remesher {
                 )));
             }
         }
+        certify_faces_at_vertices(input)?;
         // Unreferenced vertices carry no surface; drop them. The compaction keeps the order of
         // the other vertices, and the user metric follows them through the map.
         let (file_mesh, map) = input.without_unreferenced_vertices();
@@ -178,14 +186,11 @@ impl Remesher {
         options.sizes.hmin = options.sizes.hmin.map(|h| h * norm.scale);
         options.sizes.hmax = options.sizes.hmax.map(|h| h * norm.scale);
         let defaults;
-        let stages = match (&self.stages, metric.is_some()) {
-            (Some(s), _) => s,
-            (None, user) => {
-                defaults = if user {
-                    Stages::for_user_metric()
-                } else {
-                    Stages::default()
-                };
+        let stages = match &self.stages {
+            Some(s) => s,
+            None => {
+                let sizes = crate::registry::MetricSizes::of_user_metric(metric.is_some());
+                defaults = Stages::for_sizes(sizes);
                 &defaults
             }
         };
@@ -275,5 +280,61 @@ fn to_file_units(
     TriMesh {
         positions,
         triangles: out.triangles.clone(),
+    }
+}
+
+/// Refuse an input vertex that is a corner of more than [`MAX_FACES_AT_VERTEX`] faces,
+/// before any work ([`PipelineError::CrowdedVertex`]).
+fn certify_faces_at_vertices(input: &TriMesh) -> Result<(), PipelineError> {
+    let mut faces = vec![0usize; input.n_vertices()];
+    for t in &input.triangles {
+        for v in t {
+            faces[v.idx()] += 1;
+        }
+    }
+    match faces
+        .iter()
+        .enumerate()
+        .max_by_key(|&(i, n)| (*n, std::cmp::Reverse(i)))
+    {
+        Some((v, &n)) if n > MAX_FACES_AT_VERTEX => Err(PipelineError::CrowdedVertex {
+            vertex: VertexId::new(v),
+            faces: n,
+            max: MAX_FACES_AT_VERTEX,
+        }),
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point3;
+
+    /// A planar fan of `n` faces around vertex 0.
+    fn fan(n: usize) -> TriMesh {
+        let mut positions = vec![Point3::origin()];
+        positions.extend((0..=n).map(|i| {
+            let a = 1.5 * std::f64::consts::PI * i as f64 / n as f64;
+            Point3::new(a.cos(), a.sin(), 0.0)
+        }));
+        let tris: Vec<[usize; 3]> = (1..=n).map(|i| [0, i, i + 1]).collect();
+        TriMesh::from_indices(positions, &tris).expect("fan")
+    }
+
+    #[test]
+    fn a_vertex_at_the_bound_is_taken_and_one_past_it_is_refused_by_id() {
+        assert!(certify_faces_at_vertices(&fan(MAX_FACES_AT_VERTEX)).is_ok());
+        let refused = certify_faces_at_vertices(&fan(MAX_FACES_AT_VERTEX + 1));
+        assert!(
+            matches!(
+                refused,
+                Err(PipelineError::CrowdedVertex { vertex, faces, max })
+                    if vertex == VertexId::new(0)
+                        && faces == MAX_FACES_AT_VERTEX + 1
+                        && max == MAX_FACES_AT_VERTEX
+            ),
+            "{refused:?}"
+        );
     }
 }
