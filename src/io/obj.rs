@@ -201,7 +201,7 @@ fn face_line(
                 line: l,
                 face: f,
                 index: written,
-                n_vertices: n_vertices,
+                n_vertices,
             });
         };
         faces.push(v);

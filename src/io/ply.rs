@@ -303,12 +303,15 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
     Ok(h)
 }
 
+/// Numbered text lines.
+type HeaderLines<'b> = Vec<(usize, &'b str)>;
+
 /// The header's text lines with their numbers (the magic `ply` first, `end_header` left
 /// out), the body's byte offset and the number of the `end_header` line.
 fn header_lines<'b>(
     bytes: &'b [u8],
     path: &str,
-) -> Result<(Vec<(usize, &'b str)>, usize, usize), IoError> {
+) -> Result<(HeaderLines<'b>, usize, usize), IoError> {
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(IoError::Empty {
             path: path.to_string(),
