@@ -440,15 +440,24 @@ impl State<'_> {
         if shared != 2 || rf.intersection(&rt).count() != 2 {
             return None;
         }
-        // The new edges stay within the lengths Algorithm 1 makes (edges up to 1.4 L_tar in the
-        // metric): a longer one would cut across the surface the patch lies on.
-        let p = self.pts[to as usize];
-        let too_long = rf.iter().filter(|&&u| u != to).any(|&u| {
-            let e = self.pts[u as usize] - p;
-            let m = (self.tensors[u as usize] + self.tensors[to as usize]) / 2.0;
-            e.dot(&(m * e)).max(0.0).sqrt() > MAX_COLLAPSED_EDGE * self.l_tar
-        });
-        if too_long {
+        // The new edges are no longer than the longest edge around the pair now, nor than the
+        // lengths Algorithm 1 makes (1.4 L_tar in the metric): where the fidelity control made
+        // the mesh finer than the metric asks, a longer edge would cut across the surface.
+        let len = |u: u32, v: u32| {
+            let e = self.pts[u as usize] - self.pts[v as usize];
+            let m = (self.tensors[u as usize] + self.tensors[v as usize]) / 2.0;
+            e.dot(&(m * e)).max(0.0).sqrt()
+        };
+        let longest = self
+            .live_star(from, dead)
+            .chain(self.live_star(to, dead))
+            .flat_map(|t| {
+                let t = self.tris[t as usize];
+                [len(t[0], t[1]), len(t[1], t[2]), len(t[2], t[0])]
+            })
+            .fold(0.0, f64::max)
+            .min(MAX_COLLAPSED_EDGE * self.l_tar);
+        if rf.iter().any(|&u| u != to && len(u, to) > longest) {
             return None;
         }
         let mut after = Vec::new();
@@ -763,6 +772,53 @@ mod tests {
             boundary: vec![0, 1, 2, 3],
             constrained_edges: Vec::new(),
         }
+    }
+
+    /// An obtuse triangle split at an inner vertex: whatever its position, one of the parts
+    /// has an angle of at most half the base angle (19.3°); the triangle itself has 38.7°.
+    fn split_triangle() -> PlanarDomain {
+        PlanarDomain {
+            points: vec![
+                Point2::new(0.0, 0.0),
+                Point2::new(2.0, 0.0),
+                Point2::new(1.0, 0.8),
+                Point2::new(1.0, 0.3),
+            ],
+            triangles: vec![[0, 1, 3], [1, 2, 3], [2, 0, 3]],
+            boundary: vec![0, 1, 2],
+            constrained_edges: Vec::new(),
+        }
+    }
+
+    fn smallest_angle(m: &PlanarMesh) -> f64 {
+        m.triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|v| m.points[v as usize]);
+                let (l, _) = crate::remesh2d::stats::sides_and_quality(&p, &Matrix2::identity());
+                smallest_angle_deg(l)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn an_inner_vertex_no_move_can_place_well_is_collapsed() -> Result<(), Remesh2dError> {
+        let dom = split_triangle();
+        let off = Eq5Options {
+            collapse_below_deg: 0.0,
+            ..Eq5Options::default()
+        };
+        let (kept, counts) = improve_planar(&dom, &Iso, 2.0, &off)?;
+        assert_eq!((counts.collapses, kept.triangles.len()), (0, 3));
+        let (out, counts) = improve_planar(&dom, &Iso, 2.0, &Eq5Options::default())?;
+        certify_planar(&dom, &out).expect("certified");
+        assert_eq!(counts.collapses, 1, "{counts:?}");
+        assert_eq!(out.triangles.len(), 1);
+        assert_eq!(out.points, dom.points[..3], "boundary kept bit for bit, inner vertex gone");
+        assert_eq!(out.origin, vec![Some(0), Some(1), Some(2)]);
+        let (before, after) = (smallest_angle(&kept), smallest_angle(&out));
+        assert!(before < 19.4 && (after - 38.66).abs() < 0.01, "{before}° → {after}°");
+        Ok(())
     }
 
     #[test]
