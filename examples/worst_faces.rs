@@ -38,7 +38,7 @@ fn main() {
         None => None,
     };
     let mut stages = match metric {
-        Some(_) => Stages::for_user_metric(),
+        Some(_) => Stages::for_sizes(conemesh::registry::MetricSizes::Absolute),
         None => Stages::default(),
     };
     if a.iter().any(|s| s == "--no-improve") {

@@ -1,13 +1,15 @@
 //! The contract of every registered implementation of every extension point
 //! (`conemesh::contract`), on seeded random inputs: every patch strategy over covering runs
 //! (partly processed meshes, corners, feature edges), every parameterizer on disks cut from
-//! curved surfaces, every planar remesher on polygons in isotropic and anisotropic metrics.
-//! A row added to a registry is checked here without a new test.
+//! curved surfaces, every planar remesher on polygons in isotropic and anisotropic metrics,
+//! every improver on remeshed surfaces; and every row's own contract (its name and its
+//! documented defaults). A row added to a registry is checked here without a new test.
 
 #[path = "seed.rs"]
 mod seed;
-use conemesh::contract::{self, StrategyCase};
+use conemesh::contract::{self, ImproverCase, StrategyCase};
 use conemesh::ids::{EdgeKey, FaceId};
+use conemesh::improve::IMPROVERS;
 use conemesh::mesh::{generators, Topology, TriMesh};
 use conemesh::param::PARAMETERIZERS;
 use conemesh::patches::{corner_vertices, extract_patch, STRATEGIES};
@@ -40,6 +42,45 @@ fn creases(mesh: &TriMesh) -> HashSet<EdgeKey> {
     conemesh::features::sharp_edges(mesh, &topo, 45.0)
         .into_iter()
         .collect()
+}
+
+/// Every row of every built-in table builds under its name, with its documented defaults,
+/// for both kinds of sizes.
+#[test]
+fn every_row_keeps_its_own_contract() {
+    fn check<T: ?Sized + conemesh::registry::Stage>(rows: &[conemesh::registry::Entry<T>]) {
+        for row in rows {
+            if let Err(e) = contract::registry_row(row) {
+                panic!("{} `{}`: {e}", T::KIND, row.name);
+            }
+        }
+    }
+    check(STRATEGIES);
+    check(PARAMETERIZERS);
+    check(REMESHERS);
+    check(IMPROVERS);
+}
+
+proptest! {
+    #![proptest_config(config(3))]
+
+    /// Every registered improver keeps its contract after Algorithm 1 on a torus, a plate
+    /// with holes and a lens (certified, reproducible, reported under its name).
+    #[test]
+    fn every_improver_keeps_its_contract(kind in 0u8..3, seed in 0u64..1000) {
+        let mesh = match kind {
+            0 => generators::torus(1.0, 0.35, 24, 10),
+            1 => generators::genus_plate(1, 1),
+            _ => generators::lens(0.9, 5, 12),
+        };
+        let case = ImproverCase { mesh: &mesh, seed };
+        for entry in IMPROVERS {
+            let improver = conemesh::improve::improver(entry.name, Params::default())
+                .expect("default options");
+            let r = contract::improver(improver, &case);
+            prop_assert!(r.is_ok(), "{}: {}", entry.name, r.unwrap_err());
+        }
+    }
 }
 
 proptest! {
@@ -140,7 +181,7 @@ proptest! {
     /// both flip rules.
     #[test]
     fn the_planar_updates_of_algorithm_2_keep_the_contract(case in 0usize..6, seed in 0u64..1000) {
-        use conemesh::improve::{Eq5Improver, Eq5Options, FlipRule};
+        use conemesh::improve::{Eq5Updates, Eq5Options, FlipRule};
         let (domain, metric) = conemesh::remesh2d::demo_cases()[case];
         let boundary = resample_polygon(&domain.corners(), &metric, 0.15);
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
@@ -149,7 +190,7 @@ proptest! {
             .collect();
         let dom = triangulate_polygon(&boundary, &inside).expect("a triangulated polygon");
         for flip_rule in [FlipRule::Energy, FlipRule::MaxMin] {
-            let improver = Eq5Improver {
+            let improver = Eq5Updates {
                 options: Eq5Options { flip_rule, ..Eq5Options::default() },
             };
             let r = contract::planar_remesher(&improver, &dom, &metric, 0.15, seed);

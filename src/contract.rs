@@ -1,18 +1,22 @@
 //! The contracts of the research extension points, as checks anyone can run on an
-//! implementation: [`patch_strategy`], [`parameterizer`], [`planar_remesher`]. The property
-//! tests run them over every row of every registry (`proptests/contract.rs`), so a new method
-//! added to a registry is checked without writing a test; a researcher can call them on a
-//! method before registering it.
+//! implementation: [`patch_strategy`], [`parameterizer`], [`planar_remesher`], [`improver`],
+//! and on a registry row: [`registry_row`]. The property tests run them over every row of
+//! every registry (`proptests/contract.rs`), so a new method added to a registry is checked
+//! without writing a test; a researcher can call them on a method before registering it, or
+//! on rows of their own (`tests/extension.rs` does, for a method of each kind).
 //!
 //! Each check exercises the implementation on the inputs given, verifies every promise of
 //! the trait's documentation with the exact certificates of [`crate::invariants`], and
 //! returns the first broken promise, naming the elements.
 
 use crate::ids::{EdgeKey, FaceId};
+use crate::improve::{Improver, ImproverCounts};
 use crate::invariants::{self, InvariantError};
 use crate::mesh::{PlanarDomain, Topology, TriMesh};
 use crate::param::Parameterizer;
 use crate::patches::{interior_corner, interior_feature, PatchContext, PatchStrategy};
+use crate::pipeline::{RemeshOptions, Remesher, Stages};
+use crate::registry::{Entry, MetricSizes, Params, Stage};
 use crate::remesh2d::{Metric2d, PlanarRemesher};
 use crate::Rng;
 use rand::SeedableRng;
@@ -48,6 +52,95 @@ pub enum ContractViolation {
         /// what was promised and what happened
         message: String,
     },
+}
+
+/// The contract of a registry row: for either kind of sizes it builds with its defaults, the
+/// built implementation's `name()` is the row's name, the options' names are distinct, and
+/// every option given its documented default explicitly (`KEY=DEFAULT`) is taken.
+pub fn registry_row<T: ?Sized + Stage>(row: &Entry<T>) -> Result<(), ContractViolation> {
+    let name = row.name;
+    let failed = |message: String| ContractViolation::Failed { name, message };
+    let table = std::slice::from_ref(row);
+    for (i, o) in row.options.iter().enumerate() {
+        if row.options[..i].iter().any(|p| p.name == o.name) {
+            return Err(ContractViolation::Broken {
+                name,
+                message: format!("option `{}` is listed twice", o.name),
+            });
+        }
+    }
+    for sizes in MetricSizes::ALL {
+        crate::registry::build(table, name, Params::default(), sizes)
+            .map_err(|e| failed(e.to_string()))?;
+        for o in row.options {
+            let mut given = Params::default();
+            given.set(o.name, (o.default)(sizes));
+            crate::registry::build(table, name, given, sizes)
+                .map_err(|e| failed(format!("its documented default, for {sizes:?} sizes: {e}")))?;
+        }
+    }
+    Ok(())
+}
+
+/// What an improver is run on: a mesh remeshed by Algorithm 1 with the default stages and
+/// `seed`, then improved.
+pub struct ImproverCase<'a> {
+    /// A closed or bounded manifold mesh.
+    pub mesh: &'a TriMesh,
+    /// Seed of the run.
+    pub seed: u64,
+}
+
+/// The contract of [`Improver`]: its options validate; a run of the default loop stages with
+/// it as the only improver ends `Ok` (so every patch it replaced and the whole output passed
+/// their certificates); the improvement report has one step, under its name; and the same
+/// seed gives the same mesh bit for bit. Returns its counts.
+pub fn improver(
+    improver: Box<dyn Improver>,
+    case: &ImproverCase<'_>,
+) -> Result<ImproverCounts, ContractViolation> {
+    let name = improver.name();
+    let broken = |message: String| ContractViolation::Broken { name, message };
+    improver
+        .validate()
+        .map_err(|message| ContractViolation::Failed {
+            name,
+            message: format!("its options do not validate: {message}"),
+        })?;
+    let remesher = Remesher::new(RemeshOptions {
+        seed: case.seed,
+        ..RemeshOptions::default()
+    })
+    .with_stages(Stages {
+        improvers: vec![improver],
+        ..Stages::for_sizes(MetricSizes::Relative)
+    });
+    let run = || {
+        remesher
+            .run(case.mesh)
+            .map_err(|e| ContractViolation::Failed {
+                name,
+                message: e.to_string(),
+            })
+    };
+    let out = run()?;
+    let Some(report) = &out.unit.report.improvement else {
+        return Err(broken("the run has no improvement report".into()));
+    };
+    let [step] = report.steps.as_slice() else {
+        return Err(broken(format!(
+            "{} improvement steps for one improver",
+            report.steps.len()
+        )));
+    };
+    if step.name != name {
+        return Err(broken(format!("its step is named `{}`", step.name)));
+    }
+    let again = run()?;
+    if again.mesh.positions != out.mesh.positions || again.mesh.triangles != out.mesh.triangles {
+        return Err(broken("the same seed gave a different mesh".into()));
+    }
+    Ok(step.counts)
 }
 
 /// What a patch strategy is run on: a mesh, the faces already processed, and optionally

@@ -1,9 +1,20 @@
 //! One registry table per research extension point (patch strategy, parameterizer, planar
-//! remesher): name → constructor and its options. A new method is one new file plus one row
-//! in its table ([`crate::patches::STRATEGIES`], [`crate::param::PARAMETERIZERS`],
-//! [`crate::remesh2d::REMESHERS`]); `conemesh remesh --strategy/--param/--remesher NAME`
-//! and `--strategy-opt/--param-opt/--remesher-opt KEY=VALUE` reach every row, and the
-//! contract checks ([`crate::contract`]) run over every row.
+//! remesher, improver). A row ([`Entry`]) is the one source of truth for its method: the name,
+//! a summary, the options with their defaults (read from the method's own `Default`), and the
+//! constructor. The built-in tables are [`crate::patches::STRATEGIES`],
+//! [`crate::param::PARAMETERIZERS`], [`crate::remesh2d::REMESHERS`] and
+//! [`crate::improve::IMPROVERS`]; the first row of each is the default stage (for improvers,
+//! every row in order is the default list). A [`Registry`] starts from a built-in table and
+//! takes rows written anywhere, in the crate or outside it.
+//!
+//! `conemesh remesh --strategy/--param/--remesher NAME`, `--improvers A,B` and
+//! `--strategy-opt/--param-opt/--remesher-opt KEY=VALUE`, `--improver-opt NAME.KEY=VALUE`
+//! reach every built-in row, and the contract checks ([`crate::contract`]) run over every row.
+//!
+//! A row's constructor is told the kind of sizes of the run's metric ([`MetricSizes`]): a
+//! user's metric asks for absolute sizes, and a method may set some of its defaults for them
+//! (the cone strategy trims ragged expansions, LCT starts from the boundary with density
+//! control). That is the one way a run asks for absolute sizes.
 
 use std::collections::BTreeMap;
 use std::str::FromStr;
@@ -15,7 +26,7 @@ pub enum RegistryError {
     /// No row of that name.
     #[error("unknown {kind} `{name}` (known: {known})")]
     UnknownName {
-        /// "patch strategy", "parameterizer", "planar remesher"
+        /// "patch strategy", "parameterizer", "planar remesher", "improver"
         kind: &'static str,
         /// the name asked for
         name: String,
@@ -51,15 +62,82 @@ pub enum RegistryError {
     /// An option not written `KEY=VALUE`.
     #[error("option `{0}` is not of the form KEY=VALUE")]
     Malformed(String),
+    /// A row whose constructor built an implementation of another name (`name()` must be
+    /// the row's name: reports and `--improver-opt NAME.KEY` go by it).
+    #[error("{kind} row `{row}` built an implementation named `{built}`")]
+    WrongName {
+        /// the extension point
+        kind: &'static str,
+        /// the row
+        row: &'static str,
+        /// the built implementation's `name()`
+        built: &'static str,
+    },
+    /// A row added to a registry that already has a row of that name.
+    #[error("{kind} `{name}` is already registered")]
+    Duplicate {
+        /// the extension point
+        kind: &'static str,
+        /// the name
+        name: &'static str,
+    },
 }
 
-/// One option of a row: its name and what it means, with its default.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+/// The kind of sizes of a run's metric, which a row's constructor may set defaults for.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Hash)]
+pub enum MetricSizes {
+    /// Sizes relative to the input: the curvature metric, scaled so that the target length is
+    /// a multiple of the input's mean metric edge length (the paper's protocol).
+    #[default]
+    Relative,
+    /// Absolute sizes: a user's metric, meant as given.
+    Absolute,
+}
+
+impl MetricSizes {
+    /// Both kinds, for checks that cover every default.
+    pub const ALL: [MetricSizes; 2] = [MetricSizes::Relative, MetricSizes::Absolute];
+
+    /// `Absolute` for a user's metric, else `Relative`.
+    pub fn of_user_metric(user_metric: bool) -> MetricSizes {
+        match user_metric {
+            true => MetricSizes::Absolute,
+            false => MetricSizes::Relative,
+        }
+    }
+}
+
+/// One option of a row: its name, what it means, and its default as data.
+#[derive(Copy, Clone, Debug)]
 pub struct OptionDoc {
     /// Name as written in `KEY=VALUE`.
     pub name: &'static str,
-    /// Meaning and default.
+    /// Meaning (the default is [`OptionDoc::default`], not repeated here).
     pub doc: &'static str,
+    /// The default for a metric of each kind of sizes, written as a `VALUE` the constructor
+    /// takes (`none` for an option that is off). Read from the method's own defaults (its
+    /// `Default` value), so the two cannot drift; the contract check
+    /// [`crate::contract::registry_row`] holds that the constructor takes it.
+    pub default: fn(MetricSizes) -> String,
+}
+
+impl OptionDoc {
+    /// The defaults as one line: `[4]`, or `[4; 6 with a user metric]` where they differ.
+    pub fn defaults(&self) -> String {
+        let (rel, abs) = (
+            (self.default)(MetricSizes::Relative),
+            (self.default)(MetricSizes::Absolute),
+        );
+        match rel == abs {
+            true => format!("[{rel}]"),
+            false => format!("[{rel}; {abs} with a user metric]"),
+        }
+    }
+}
+
+/// `x` as an option value: `none` for `None`.
+pub fn optional<T: ToString>(x: Option<T>) -> String {
+    x.map_or_else(|| "none".to_string(), |x| x.to_string())
 }
 
 /// The `KEY=VALUE` options given for one row. A constructor takes the ones it knows
@@ -153,25 +231,65 @@ impl Params {
     }
 }
 
+impl Params {
+    /// [`Params::take_checked`] for an option that may be off: `none` turns it off
+    /// (`Some(None)`).
+    pub fn take_optional<T: FromStr + Copy>(
+        &mut self,
+        key: &str,
+        expected: &'static str,
+        valid: impl Fn(T) -> bool,
+    ) -> Result<Option<Option<T>>, BadValue> {
+        if self.given.get(key).is_some_and(|v| v == "none") {
+            self.given.remove(key);
+            return Ok(Some(None));
+        }
+        Ok(self.take_checked(key, expected, valid)?.map(Some))
+    }
+}
+
 /// One row of a registry: a name, a one-line summary, the options and the constructor.
 pub struct Entry<T: ?Sized> {
-    /// Name on the command line and in reports.
+    /// Name on the command line and in reports; the built implementation's `name()` is this
+    /// ([`build`] refuses a row that builds another).
     pub name: &'static str,
     /// One line: what the method is (and its paper section or reference).
     pub summary: &'static str,
-    /// The options the constructor takes.
+    /// The options the constructor takes, with their defaults.
     pub options: &'static [OptionDoc],
-    /// Build the implementation from its options (the ones it takes are removed).
-    pub build: fn(&mut Params) -> Result<Box<T>, BadValue>,
+    /// Build the implementation from its options (the ones it takes are removed), for a
+    /// metric with `sizes`.
+    pub build: fn(&mut Params, MetricSizes) -> Result<Box<T>, BadValue>,
 }
 
-/// Build row `name` of `table` with `params`; `kind` names the extension point in errors.
-pub fn build<T: ?Sized>(
-    kind: &'static str,
+impl<T: ?Sized> Clone for Entry<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T: ?Sized> Copy for Entry<T> {}
+
+/// An extension point's trait object (`dyn PatchStrategy`, …): what names it in errors, its
+/// built-in table, and the name of a built implementation.
+pub trait Stage: 'static {
+    /// "patch strategy", "parameterizer", "planar remesher", "improver".
+    const KIND: &'static str;
+    /// The built-in rows, the default first.
+    fn builtin() -> &'static [Entry<Self>];
+    /// The implementation's `name()`.
+    fn stage_name(&self) -> &'static str;
+}
+
+/// Build row `name` of `table` with `params` for a metric with `sizes`; the built
+/// implementation must carry the row's name.
+pub fn build<T: ?Sized + Stage>(
     table: &[Entry<T>],
     name: &str,
     mut params: Params,
+    sizes: MetricSizes,
 ) -> Result<Box<T>, RegistryError> {
+    let kind = T::KIND;
     let entry =
         table
             .iter()
@@ -181,7 +299,7 @@ pub fn build<T: ?Sized>(
                 name: name.to_string(),
                 known: names(table).join(", "),
             })?;
-    let built = (entry.build)(&mut params).map_err(|b| RegistryError::BadValue {
+    let built = (entry.build)(&mut params, sizes).map_err(|b| RegistryError::BadValue {
         kind,
         name: entry.name,
         option: b.option,
@@ -199,12 +317,82 @@ pub fn build<T: ?Sized>(
             },
         });
     }
+    if built.stage_name() != entry.name {
+        return Err(RegistryError::WrongName {
+            kind,
+            row: entry.name,
+            built: built.stage_name(),
+        });
+    }
     Ok(built)
 }
 
 /// The names of a table, in order (the first is the default).
 pub fn names<T: ?Sized>(table: &[Entry<T>]) -> Vec<&'static str> {
     table.iter().map(|e| e.name).collect()
+}
+
+/// The name of the default row of an extension point (the first of its built-in table).
+pub fn default_name<T: ?Sized + Stage>() -> &'static str {
+    T::builtin().first().map_or("", |e| e.name)
+}
+
+/// The first row of `table` built with its default options for `sizes`: the default stage.
+/// A built-in table's first row builds with its defaults (the contract checks hold it).
+pub fn build_default<T: ?Sized + Stage>(
+    table: &[Entry<T>],
+    sizes: MetricSizes,
+) -> Result<Box<T>, RegistryError> {
+    let first = table.first().map_or("", |e| e.name);
+    build(table, first, Params::default(), sizes)
+}
+
+/// The rows of one extension point: a built-in table and rows added to it from anywhere
+/// (a method defined outside the crate is one row, [`Registry::with`]).
+pub struct Registry<T: ?Sized + 'static> {
+    rows: Vec<Entry<T>>,
+}
+
+impl<T: ?Sized + Stage> Default for Registry<T> {
+    fn default() -> Self {
+        Registry::builtin()
+    }
+}
+
+impl<T: ?Sized + Stage> Registry<T> {
+    /// The built-in rows.
+    pub fn builtin() -> Registry<T> {
+        Registry {
+            rows: T::builtin().to_vec(),
+        }
+    }
+
+    /// The same with `row` added last; refused when a row of that name exists.
+    pub fn with(mut self, row: Entry<T>) -> Result<Registry<T>, RegistryError> {
+        if self.rows.iter().any(|e| e.name == row.name) {
+            return Err(RegistryError::Duplicate {
+                kind: T::KIND,
+                name: row.name,
+            });
+        }
+        self.rows.push(row);
+        Ok(self)
+    }
+
+    /// Every row, the default first.
+    pub fn rows(&self) -> &[Entry<T>] {
+        &self.rows
+    }
+
+    /// Build row `name` with `params` for a metric with `sizes` (see [`build`]).
+    pub fn build(
+        &self,
+        name: &str,
+        params: Params,
+        sizes: MetricSizes,
+    ) -> Result<Box<T>, RegistryError> {
+        build(&self.rows, name, params, sizes)
+    }
 }
 
 #[cfg(test)]
@@ -220,7 +408,16 @@ mod tests {
             "hello".repeat(self.0)
         }
     }
-    fn parrot(p: &mut Params) -> Result<Box<dyn Speak>, BadValue> {
+    impl Stage for dyn Speak {
+        const KIND: &'static str = "speaker";
+        fn builtin() -> &'static [Entry<Self>] {
+            TABLE
+        }
+        fn stage_name(&self) -> &'static str {
+            "parrot"
+        }
+    }
+    fn parrot(p: &mut Params, _: MetricSizes) -> Result<Box<dyn Speak>, BadValue> {
         let n = p.take_checked("times", "a positive integer", |n: usize| n > 0)?;
         Ok(Box::new(Parrot(n.unwrap_or(1))))
     }
@@ -229,7 +426,8 @@ mod tests {
         summary: "repeats",
         options: &[OptionDoc {
             name: "times",
-            doc: "repetitions [1]",
+            doc: "repetitions",
+            default: |_| "1".into(),
         }],
         build: parrot,
     }];
@@ -237,23 +435,23 @@ mod tests {
     #[test]
     fn builds_by_name_with_options_and_refuses_what_it_does_not_know() {
         let p = |s: &[&str]| Params::parse(s).expect("parses");
-        let b = build("speaker", TABLE, "parrot", p(&[])).expect("default");
+        let b = build(TABLE, "parrot", p(&[]), MetricSizes::Relative).expect("default");
         assert_eq!(b.word(), "hello");
-        let b = build("speaker", TABLE, "parrot", p(&["times=2"])).expect("option");
+        let b = build(TABLE, "parrot", p(&["times=2"]), MetricSizes::Relative).expect("option");
         assert_eq!(b.word(), "hellohello");
         assert!(matches!(
-            build("speaker", TABLE, "crow", p(&[])),
+            build(TABLE, "crow", p(&[]), MetricSizes::Relative),
             Err(RegistryError::UnknownName { known, .. }) if known == "parrot"
         ));
         assert!(matches!(
-            build("speaker", TABLE, "parrot", p(&["volume=3"])),
+            build(TABLE, "parrot", p(&["volume=3"]), MetricSizes::Relative),
             Err(RegistryError::UnknownOption { option, known, .. })
                 if option == "volume" && known == "times"
         ));
         for bad in ["times=0", "times=x", "times=-1"] {
             assert!(
                 matches!(
-                    build("speaker", TABLE, "parrot", p(&[bad])),
+                    build(TABLE, "parrot", p(&[bad]), MetricSizes::Relative),
                     Err(RegistryError::BadValue { option, .. }) if option == "times"
                 ),
                 "{bad}"
@@ -263,6 +461,30 @@ mod tests {
             Params::parse(&["times"]),
             Err(RegistryError::Malformed("times".into()))
         );
+        // A row added to a registry builds by name; a second row of the same name is refused.
+        static CROW: Entry<dyn Speak> = Entry {
+            name: "crow",
+            summary: "caws",
+            options: &[],
+            build: |_, _| Ok(Box::new(Parrot(2))),
+        };
+        let reg = Registry::<dyn Speak>::builtin()
+            .with(CROW)
+            .expect("a new name");
+        assert_eq!(names(reg.rows()), ["parrot", "crow"]);
+        // The crow's constructor builds a parrot: refused by name.
+        assert!(matches!(
+            reg.build("crow", p(&[]), MetricSizes::Relative),
+            Err(RegistryError::WrongName {
+                row: "crow",
+                built: "parrot",
+                ..
+            })
+        ));
+        assert!(matches!(
+            reg.with(TABLE[0]),
+            Err(RegistryError::Duplicate { name: "parrot", .. })
+        ));
         assert_eq!(
             Params::parse(&["=3"]),
             Err(RegistryError::Malformed("=3".into()))

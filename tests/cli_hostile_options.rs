@@ -158,7 +158,8 @@ fn all_outputs_as_one_transaction_remesh_undoes_the_mesh_when_the_last_plot_fail
         "--plots",
         &s("plots"),
         "--quiet",
-        "--no-improve",
+        "--improvers",
+        "surface",
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -188,7 +189,8 @@ fn all_outputs_as_one_transaction_remesh_undoes_the_mesh_when_the_last_plot_fail
         "--plots",
         &s("plots"),
         "--quiet",
-        "--no-improve",
+        "--improvers",
+        "surface",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let mesh = conemesh::io::read_mesh(&d("out.obj")).expect("new mesh");
@@ -279,7 +281,8 @@ fn output_paths_that_are_not_utf8_are_written_and_reported_lossily() {
             "-q",
             "--max-patches",
             "2",
-            "--no-improve",
+            "--improvers",
+            "surface",
             "-o",
         ])
         .arg(&out)

@@ -3,7 +3,8 @@
 //! `Improver` extension point from outside the crate.
 
 use conemesh::improve::{
-    Algorithm2, ImproveOptions, ImproveRun, Improver, ImproverCounts, RunError, SurfacePasses,
+    Algorithm2, ImproveOptions, ImproveRun, Improver, ImproverCounts, LoopStages, RunError,
+    SurfacePasses,
 };
 use conemesh::invariants::certify_boundary_on_curves;
 use conemesh::mesh::{Topology, TriMesh};
@@ -90,18 +91,16 @@ fn the_screwdriver_loses_small_angles_and_stays_certified() {
     // Without it the run makes fewer patches and ends at the surface passes' row.
     let plain = Remesher::new(seeded(1)).run(&input).expect("remeshes");
     let p = plain.unit.report.improvement.as_ref().expect("surface ran");
-    assert_eq!(
-        plain.unit.report.improvers,
-        conemesh::pipeline::DEFAULT_IMPROVERS
-    );
-    if !conemesh::pipeline::DEFAULT_IMPROVERS.contains(&"eq5") {
+    let defaults = conemesh::pipeline::default_improver_names();
+    assert_eq!(plain.unit.report.improvers, defaults);
+    if !defaults.contains(&"eq5") {
         assert!(plain.unit.report.patches < r.patches);
         assert_eq!(p.after, surface.after);
     }
 }
 
 /// A research improver written outside the crate: one patch pass over every face through
-/// Algorithm 1's own stages, whose every candidate it refuses.
+/// the run's own stages, whose every candidate it refuses.
 struct RefuseEverything;
 
 impl Improver for RefuseEverything {
@@ -110,12 +109,12 @@ impl Improver for RefuseEverything {
     }
     fn improve(
         &self,
+        stages: LoopStages<'_>,
         run: &mut dyn ImproveRun,
         rng: &mut conemesh::Rng,
     ) -> Result<ImproverCounts, RunError> {
         let all = vec![true; run.working_mesh().mesh.n_faces()];
-        let stages = Stages::default();
-        let pass = run.patch_pass(stages.loop_stages(), &all, None, &|_, _| false, rng)?;
+        let pass = run.patch_pass(stages, &all, None, &|_, _| false, rng)?;
         Ok(ImproverCounts {
             passes: 1,
             patches: pass.patches,
@@ -219,9 +218,8 @@ fn the_cli_reports_and_plots_the_step_and_refuses_bad_values() {
             .expect("runs")
     };
     let o = run(&[
-        "--improve",
-        "--improve-q",
-        "0.9",
+        "--improver-opt",
+        "eq5.q=0.9",
         "--report",
         report.to_str().unwrap(),
         "--plots",
@@ -248,10 +246,10 @@ fn the_cli_reports_and_plots_the_step_and_refuses_bad_values() {
     );
     assert!(plots.join("hist_min_angles_improve.png").is_file());
     for (bad, named) in [
-        (&["--improve", "--improve-q", "1.5"][..], "`q`"),
-        (&["--improve", "--improve-w", "nan"], "`w`"),
-        (&["--improve", "--improve-rings", "0"], "`rings`"),
-        (&["--improve", "--improver-opt", "eq5.q=2"], "`q`"),
+        (&["--improver-opt", "eq5.q=1.5"][..], "`q`"),
+        (&["--improver-opt", "eq5.w=nan"], "`w`"),
+        (&["--improver-opt", "eq5.rings=0"], "`rings`"),
+        (&["--improver-opt", "eq5.q=2"], "`q`"),
         (
             &["--improvers", "surface", "--improver-opt", "eq5.q=0.5"],
             "does not run",
@@ -261,10 +259,6 @@ fn the_cli_reports_and_plots_the_step_and_refuses_bad_values() {
         (
             &["--improvers", "surface,laplace"],
             "unknown improver `laplace`",
-        ),
-        (
-            &["--improvers", "surface", "--improve-q", "0.5"],
-            "does not run",
         ),
     ] {
         std::fs::remove_file(&out_mesh).ok();

@@ -23,7 +23,7 @@ fn run(mesh: &TriMesh, metric: Option<&[Matrix3<f64>]>) -> Remeshed {
         ..RemeshOptions::default()
     };
     let stages = match metric {
-        Some(_) => Stages::for_user_metric(),
+        Some(_) => Stages::for_sizes(conemesh::registry::MetricSizes::Absolute),
         None => Stages::default(),
     };
     Remesher::new(options)

@@ -210,7 +210,9 @@ def remesh(V, F, metric=None, **options):
         ``crease_metric=False``, ``coarse="auto"``, ``hmin``,
         ``hmax``, ``hgrad`` (``None``), ``keep_boundary=False``,
         ``boundary_corner_angle=45.0``, ``improvers=None`` (``"surface,eq5"``; a list is
-        joined), ``no_improve=False``, ``max_patches=None``, ``no_self_intersections=False``,
+        joined; ``"surface"`` leaves Algorithm 2 out), ``improver_opt=None`` (a list of
+        ``"NAME.KEY=VALUE"``, e.g. ``"eq5.q=0.7"``), ``max_patches=None``,
+        ``no_self_intersections=False``,
         ``repair=False`` (weld, drop zero-area faces, orient, split non-manifold elements
         first; the report's ``repair`` lists every change), ``quiet=False`` (no progress
         bar on stderr). Files: ``report``, ``plots`` (with ``mesh.png``, the output coloured

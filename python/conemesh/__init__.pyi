@@ -68,12 +68,6 @@ def remesh(
     boundary_corner_angle: float = 45.0,
     improvers: str | Sequence[str] | None = None,
     improver_opt: Sequence[str] | Mapping[str, object] | None = None,
-    improve: bool = False,
-    no_improve: bool = False,
-    improve_q: float | None = None,
-    improve_rings: int | None = None,
-    improve_flips: Literal["energy", "max-min"] | None = None,
-    improve_w: float | None = None,
     repair: bool = False,
     quiet: bool = False,
 ) -> tuple[Vertices, Faces, dict[str, Any]]: ...

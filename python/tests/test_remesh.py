@@ -106,9 +106,9 @@ def test_report_is_the_cli_report(bumpy):
 
 def test_options_reach_the_run(bumpy):
     V, F = bumpy
-    _, G1, r1 = conemesh.remesh(V, F, quiet=True, ltar_factor=3.0, no_improve=True, hausd=0)
+    _, G1, r1 = conemesh.remesh(V, F, quiet=True, ltar_factor=3.0, improvers="surface", hausd=0)
     assert r1["run"]["improvers"] == ["surface"]
-    _, G2, _ = conemesh.remesh(V, F, quiet=True, ltar_factor=1.5, no_improve=True, hausd=0)
+    _, G2, _ = conemesh.remesh(V, F, quiet=True, ltar_factor=1.5, improvers="surface", hausd=0)
     assert len(G1) < len(G2)  # a longer target edge gives fewer faces
     _, _, r3 = conemesh.remesh(V, F, quiet=True, improvers=["surface"], strategy="kring", strategy_opt={"rings": 3})
     assert r3["run"]["improvers"] == ["surface"]
@@ -123,7 +123,7 @@ def test_bad_keywords_and_values():
     with pytest.raises(conemesh.OptionError, match="cannot be used with"):
         conemesh.remesh(V, F, ltar_factor=2.0, ltar=0.1)
     with pytest.raises(conemesh.OptionError, match="True or False"):
-        conemesh.remesh(V, F, no_improve=1)
+        conemesh.remesh(V, F, keep_boundary=1)
     with pytest.raises(conemesh.OptionError, match="coarse"):
         conemesh.remesh(V, F, coarse="sometimes")
 

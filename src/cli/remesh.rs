@@ -6,22 +6,16 @@
 
 use anyhow::Context;
 use conemesh::features::FeatureRule;
+use conemesh::param::Parameterizer;
+use conemesh::patches::PatchStrategy;
 use conemesh::pipeline::{CoarseInput, Progress, RemeshOptions, Remesher, Stages};
 use conemesh::quality::{EvalOptions, EvalReport, TargetLength};
-use conemesh::registry::Params;
+use conemesh::registry::{default_name, MetricSizes, Params};
+use conemesh::remesh2d::PlanarRemesher;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-
-/// `--improve-flips`.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ImproveFlips {
-    /// When the pair's Eq. 5 energy strictly decreases.
-    Energy,
-    /// When the pair's smaller metric quality strictly increases.
-    MaxMin,
-}
 
 /// `--coarse`.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,20 +49,21 @@ pub struct RemeshArgs {
     /// Seed of the run's one RNG.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Patch strategy (Sec. 3.2), by registry name (`conemesh stages` lists them).
-    #[arg(long, default_value = "cone")]
+    /// Patch strategy (Sec. 3.2), by registry name (`conemesh stages` lists them; the
+    /// default is the table's first row).
+    #[arg(long, default_value_t = default_name::<dyn PatchStrategy>().to_string())]
     pub strategy: String,
     /// An option of the patch strategy, `KEY=VALUE` (repeatable).
     #[arg(long, value_name = "KEY=VALUE")]
     pub strategy_opt: Vec<String>,
     /// Parameterizer (Sec. 3.3), by registry name.
-    #[arg(long, default_value = "sd")]
+    #[arg(long, default_value_t = default_name::<dyn Parameterizer>().to_string())]
     pub param: String,
     /// An option of the parameterizer, `KEY=VALUE` (repeatable).
     #[arg(long, value_name = "KEY=VALUE")]
     pub param_opt: Vec<String>,
     /// Planar remesher (Sec. 3.3), by registry name.
-    #[arg(long, default_value = "lct")]
+    #[arg(long, default_value_t = default_name::<dyn PlanarRemesher>().to_string())]
     pub remesher: String,
     /// An option of the planar remesher, `KEY=VALUE` (repeatable).
     #[arg(long, value_name = "KEY=VALUE")]
@@ -86,8 +81,8 @@ pub struct RemeshArgs {
     /// Write the full report (options, certificates, per-stage times, quality) as JSON.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Write quality histograms (PNG) into this directory (with `--improve`, also the smallest
-    /// angles before and after Algorithm 2), and `mesh.png`, the picture of the output
+    /// Write quality histograms (PNG) into this directory (with improvers, also the smallest
+    /// angles before and after them), and `mesh.png`, the picture of the output
     /// coloured by q in the run's metric, faces with a smallest angle below 20° in magenta
     /// (as `conemesh render --color q` with `--write-metric`'s tensors).
     #[arg(long)]
@@ -182,36 +177,14 @@ pub struct RemeshArgs {
     #[arg(long, default_value_t = conemesh::boundary::BoundaryOptions::default().corner_angle)]
     pub boundary_corner_angle: f64,
     /// The improvers after the loop (Sec. 3.4), in order, by registry name, comma-separated
-    /// (`conemesh stages` lists them); `none` for none. Default: `surface,eq5` (the
-    /// connectivity and vertex position updates on the surface, then Algorithm 2).
+    /// (`conemesh stages` lists them); `none` for none. Default: every improver, in the order
+    /// of the table (`surface,eq5`: the connectivity and vertex position updates on the
+    /// surface, then Algorithm 2).
     #[arg(long, value_name = "LIST")]
     pub improvers: Option<String>,
     /// An option of one improver, `NAME.KEY=VALUE` (e.g. `eq5.q=0.7`); repeatable.
     #[arg(long, value_name = "NAME.KEY=VALUE")]
     pub improver_opt: Vec<String>,
-    /// Run Algorithm 2 (minimum-angle improvement, improver `eq5`; in the default list): cone
-    /// patches around the faces whose metric quality is below `--improve-q` or whose smallest
-    /// angle is below 30°, improved in the plane by the vertex position and connectivity
-    /// updates of Eq. 5-6. Adds it to `--improvers` when that list lacks it.
-    #[arg(long, conflicts_with = "no_improve")]
-    pub improve: bool,
-    /// Leave Algorithm 2 (`eq5`) out of the improvers (Algorithm 1 and the surface passes
-    /// only).
-    #[arg(long)]
-    pub no_improve: bool,
-    /// Algorithm 2: the quality below which a face is improved [0.5] (`eq5.q`).
-    #[arg(long)]
-    pub improve_q: Option<f64>,
-    /// Algorithm 2: rings of faces around a bad face that its patch takes in the first pass,
-    /// one more in each further pass [2] (`eq5.rings`).
-    #[arg(long)]
-    pub improve_rings: Option<usize>,
-    /// Algorithm 2: how the connectivity update decides a flip [energy] (`eq5.flips`).
-    #[arg(long, value_enum)]
-    pub improve_flips: Option<ImproveFlips>,
-    /// Algorithm 2: the weight w of Eq. 5 [1] (`eq5.w`).
-    #[arg(long)]
-    pub improve_w: Option<f64>,
     /// Repair the input before remeshing: leave out file faces that use a vertex twice, weld
     /// vertices at bit-identical positions, drop collapsed, zero-area and repeated faces,
     /// orient each component consistently, cut edges with three or more faces and split
@@ -591,8 +564,8 @@ pub fn options(args: &RemeshArgs) -> RemeshOptions {
     }
 }
 
-/// The three extension points by registry name, with their options. With a user metric the
-/// planar remesher's `sizes` option defaults to true (absolute sizes), as in the library.
+/// The extension points by registry name, with their options, for a metric of the kind of
+/// sizes a user metric has or not (the rows' defaults for it, as in the library).
 pub fn stages(args: &RemeshArgs, user_metric: bool) -> anyhow::Result<Stages> {
     let mut strategy = Params::parse(&args.strategy_opt)?;
     if let Some(r) = args.expand_rings {
@@ -605,45 +578,24 @@ pub fn stages(args: &RemeshArgs, user_metric: bool) -> anyhow::Result<Stages> {
         (&args.strategy, strategy),
         (&args.param, Params::parse(&args.param_opt)?),
         (&args.remesher, Params::parse(&args.remesher_opt)?),
-        user_metric,
+        MetricSizes::of_user_metric(user_metric),
     )?;
     stages.improvers = improvers(args)?;
     Ok(stages)
 }
 
-/// The improvers of `--improvers` (or the default list), with `--improve`/`--no-improve`,
-/// `--improver-opt NAME.KEY=VALUE` and the `--improve-*` shorthands of row `eq5`.
+/// The improvers of `--improvers` (or the default list), each with its options of
+/// `--improver-opt NAME.KEY=VALUE`.
 fn improvers(args: &RemeshArgs) -> anyhow::Result<Vec<Box<dyn conemesh::improve::Improver>>> {
-    let mut names: Vec<String> = match args.improvers.as_deref().map(str::trim) {
+    let names: Vec<String> = match args.improvers.as_deref().map(str::trim) {
         Some("none") | Some("") => Vec::new(),
         Some(list) => list.split(',').map(|n| n.trim().to_string()).collect(),
-        None => conemesh::pipeline::DEFAULT_IMPROVERS
-            .iter()
-            .map(|n| n.to_string())
+        None => conemesh::pipeline::default_improver_names()
+            .into_iter()
+            .map(String::from)
             .collect(),
     };
-    if args.improve && !names.iter().any(|n| n == "eq5") {
-        names.push("eq5".into());
-    }
-    if args.no_improve {
-        names.retain(|n| n != "eq5");
-    }
     let mut params: Vec<Vec<String>> = vec![Vec::new(); names.len()];
-    let mut give = |name: &str, kv: String, flag: &str| -> anyhow::Result<()> {
-        match names.iter().position(|n| n == name) {
-            Some(i) => {
-                params[i].push(kv);
-                Ok(())
-            }
-            None => anyhow::bail!(
-                "{flag} is an option of improver `{name}`, which does not run (improvers: {})",
-                match names.is_empty() {
-                    true => "none".to_string(),
-                    false => names.join(","),
-                }
-            ),
-        }
-    };
     for item in &args.improver_opt {
         let (name, kv) = item
             .split_once('.')
@@ -651,23 +603,16 @@ fn improvers(args: &RemeshArgs) -> anyhow::Result<Vec<Box<dyn conemesh::improve:
             .ok_or_else(|| {
                 anyhow::anyhow!("--improver-opt `{item}` is not of the form NAME.KEY=VALUE")
             })?;
-        give(name, kv.to_string(), "--improver-opt")?;
-    }
-    if let Some(q) = args.improve_q {
-        give("eq5", format!("q={q}"), "--improve-q")?;
-    }
-    if let Some(r) = args.improve_rings {
-        give("eq5", format!("rings={r}"), "--improve-rings")?;
-    }
-    if let Some(f) = args.improve_flips {
-        let rule = match f {
-            ImproveFlips::Energy => "energy",
-            ImproveFlips::MaxMin => "max-min",
+        let Some(i) = names.iter().position(|n| n == name) else {
+            anyhow::bail!(
+                "--improver-opt {item} is an option of improver `{name}`, which does not run (improvers: {})",
+                match names.is_empty() {
+                    true => "none".to_string(),
+                    false => names.join(","),
+                }
+            );
         };
-        give("eq5", format!("flips={rule}"), "--improve-flips")?;
-    }
-    if let Some(w) = args.improve_w {
-        give("eq5", format!("w={w}"), "--improve-w")?;
+        params[i].push(kv.to_string());
     }
     names
         .iter()

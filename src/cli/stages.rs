@@ -11,10 +11,15 @@ pub struct StagesArgs {}
 
 fn print_table<T: ?Sized>(title: &str, flag: &str, table: &[Entry<T>]) {
     println!("{title} ({flag} NAME, {flag}-opt KEY=VALUE; the first is the default):");
+    print_rows(table);
+}
+
+/// Each row: name, summary, then its options with their defaults.
+fn print_rows<T: ?Sized>(table: &[Entry<T>]) {
     for e in table {
         println!("  {:<8} {}", e.name, e.summary);
         for o in e.options {
-            println!("           {:<16} {}", o.name, o.doc);
+            println!("           {:<16} {} {}", o.name, o.doc, o.defaults());
         }
     }
 }
@@ -37,14 +42,9 @@ pub fn run(_: StagesArgs) -> anyhow::Result<ExitCode> {
         conemesh::remesh2d::REMESHERS,
     );
     println!(
-        "improvers, Sec. 3.4, run in order after the loop (--improvers A,B; --improver-opt NAME.KEY=VALUE; default: {}):",
-        conemesh::pipeline::DEFAULT_IMPROVERS.join(",")
+        "improvers, Sec. 3.4, run in order after the loop (--improvers A,B; --improver-opt NAME.KEY=VALUE; default: every one, {}):",
+        conemesh::pipeline::default_improver_names().join(",")
     );
-    for e in conemesh::improve::IMPROVERS {
-        println!("  {:<8} {}", e.name, e.summary);
-        for o in e.options {
-            println!("           {:<16} {}", o.name, o.doc);
-        }
-    }
+    print_rows(conemesh::improve::IMPROVERS);
     Ok(ExitCode::SUCCESS)
 }

@@ -2,26 +2,26 @@
 //!
 //! ```text
 //! while a face has q below the threshold and the budget is not spent:
-//!     P  = a cone patch over `rings` rings around it          // through the PatchStrategy
-//!     uv = parameterize P (certified bijective); M2 = Eq. 4
+//!     P  = a patch over `rings` rings around it               // the run's PatchStrategy
+//!     uv = parameterize P (certified bijective); M2 = Eq. 4    // the run's Parameterizer
 //!     vertex position and connectivity updates in the plane    // Eq. 5-6, improve::eq5
 //!     map back, certify and replace P                          // as a patch of Algorithm 1
 //! ```
 //!
-//! It reuses Algorithm 1's patch step with other stages ([`ImproveRun::patch_pass`]): a pass
-//! marks the faces at or above the threshold as processed, so the cone strategy seeds only at
-//! bad faces and its ring expansion takes their neighbourhood; the planar stage is
-//! [`Eq5Improver`], which keeps the patch's vertices and boundary; the patch's boundary
-//! chains are not resampled. Every replaced patch is certified as in Algorithm 1.
+//! It reuses Algorithm 1's patch step with the run's strategy and parameterizer
+//! ([`ImproveRun::patch_pass`]): a pass marks the faces at or above the threshold as
+//! processed, so the strategy seeds only at bad faces and its ring expansion
+//! ([`crate::patches::PatchStrategy::widened`]) takes their neighbourhood; the planar stage is
+//! [`Eq5Updates`], which keeps the patch's vertices and boundary (the run's planar remesher
+//! would remesh the patch instead of improving it); the patch's boundary chains are not
+//! resampled. Every replaced patch is certified as in Algorithm 1.
 //! Termination: within a pass every patch marks at least one unprocessed face processed
 //! (Algorithm 1's argument); a further pass runs only when the previous one strictly lowered
 //! the count of faces below the threshold, and there are at most `passes` of them. Each pass
 //! takes one ring more around the bad faces than the last.
 
-use super::{Eq5Improver, Eq5Options, ImproveRun, Improver, ImproverCounts};
+use super::{Eq5Options, Eq5Updates, ImproveRun, Improver, ImproverCounts};
 use super::{LoopStages, RunError};
-use crate::param::SymmetricDirichlet;
-use crate::patches::{ConeOptions, ConePatches};
 use crate::quality::TriangleQuality;
 use serde::Serialize;
 
@@ -112,10 +112,14 @@ impl Improver for Algorithm2 {
 
     fn improve(
         &self,
+        stages: LoopStages<'_>,
         run: &mut dyn ImproveRun,
         rng: &mut crate::Rng,
     ) -> Result<ImproverCounts, RunError> {
         let o = &self.options;
+        let planar = Eq5Updates {
+            options: o.planar.clone(),
+        };
         let mut counts = ImproverCounts::default();
         let mut bad_before = usize::MAX;
         while counts.passes < o.passes {
@@ -127,11 +131,15 @@ impl Improver for Algorithm2 {
             bad_before = n_bad;
             // Each pass reaches one ring farther: the faces still bad after a pass are those
             // whose patch was too small to move their vertices (they sat on its boundary).
-            let stages = PassStages::new(o, o.rings + counts.passes);
+            let widened = stages.patches.widened(o.rings + counts.passes);
+            let pass_stages = LoopStages {
+                patches: widened.as_deref().unwrap_or(stages.patches),
+                parameterizer: stages.parameterizer,
+                remesher: &planar,
+            };
             counts.passes += 1;
             let budget = o.max_patches.map(|m| m.saturating_sub(counts.patches));
-            let pass =
-                run.patch_pass(stages.borrowed(), &bad, budget, &better_at_the_bottom, rng)?;
+            let pass = run.patch_pass(pass_stages, &bad, budget, &better_at_the_bottom, rng)?;
             counts.patches += pass.patches;
             counts.rejected += pass.rejected;
             if pass.budget_exhausted {
@@ -140,38 +148,6 @@ impl Improver for Algorithm2 {
             }
         }
         Ok(counts)
-    }
-}
-
-/// Algorithm 2's stages: cone patches expanded by `rings` rings, SD, the planar updates.
-struct PassStages {
-    patches: ConePatches,
-    parameterizer: SymmetricDirichlet,
-    remesher: Eq5Improver,
-}
-
-impl PassStages {
-    fn new(o: &ImproveOptions, rings: usize) -> PassStages {
-        PassStages {
-            patches: ConePatches {
-                options: ConeOptions {
-                    expand_rings: rings,
-                    ..ConeOptions::default()
-                },
-            },
-            parameterizer: SymmetricDirichlet::default(),
-            remesher: Eq5Improver {
-                options: o.planar.clone(),
-            },
-        }
-    }
-
-    fn borrowed(&self) -> LoopStages<'_> {
-        LoopStages {
-            patches: &self.patches,
-            parameterizer: &self.parameterizer,
-            remesher: &self.remesher,
-        }
     }
 }
 

@@ -78,16 +78,19 @@ impl Default for Eq5Options {
     }
 }
 
-/// The planar updates of Algorithm 2 as a planar stage.
+/// The planar updates of Algorithm 2 (the vertex position and connectivity updates on the
+/// energy of Eq. 5) as the planar stage of its patches: a [`PlanarRemesher`] that keeps the
+/// patch's vertices. Not a registry row (it does not remesh a patch from its boundary);
+/// [`super::Algorithm2`] (improver row `eq5`) runs it.
 #[derive(Clone, Debug, Default)]
-pub struct Eq5Improver {
+pub struct Eq5Updates {
     /// Options.
     pub options: Eq5Options,
 }
 
-impl PlanarRemesher for Eq5Improver {
+impl PlanarRemesher for Eq5Updates {
     fn name(&self) -> &'static str {
-        "eq5"
+        "eq5-updates"
     }
 
     fn remesh(
@@ -888,7 +891,7 @@ mod tests {
             }
         }
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let out = Eq5Improver::default().remesh(&dom, &Iso, 0.5, &mut rng)?;
+        let out = Eq5Updates::default().remesh(&dom, &Iso, 0.5, &mut rng)?;
         certify_planar(&dom, &out).expect("certified");
         Ok(())
     }

@@ -12,14 +12,18 @@
 //!   patches were remeshed. Every change is a candidate certified like a patch's new faces
 //!   (not degenerate, not flipped, locally embedded) and keeps the surface within the distance
 //!   tolerance.
-//! - [`Algorithm2`] (row `eq5`) is Algorithm 2 proper: a cone patch around the bad triangles,
-//!   re-parameterized, the two updates in its plane on the energy of Eq. 5-6 (`eq5.rs`, a
-//!   [`crate::remesh2d::PlanarRemesher`]), mapped back and certified like a patch of
-//!   Algorithm 1 (through [`ImproveRun::patch_pass`]).
+//! - [`Algorithm2`] (row `eq5`) is Algorithm 2 proper: a patch of the run's strategy around
+//!   the bad triangles, parameterized by the run's parameterizer, the two updates in its plane
+//!   on the energy of Eq. 5-6 ([`Eq5Updates`], a [`crate::remesh2d::PlanarRemesher`] that
+//!   keeps the patch's vertices), mapped back and certified like a patch of Algorithm 1
+//!   (through [`ImproveRun::patch_pass`]).
 //!
-//! A new improver is one file here plus one row in [`IMPROVERS`]; it works through
-//! [`ImproveRun`] (implemented by the pipeline), which certifies whatever it changes. How the two compare:
-//! paper-notes.md, Sec. 3.4.
+//! Every improver is given the run's stages ([`LoopStages`]: strategy, parameterizer, planar
+//! remesher), so `--strategy` and `--param` reach the improvement too. A new improver is one
+//! file here plus one row in [`IMPROVERS`] (or a row given to a
+//! [`crate::registry::Registry`] outside the crate); it works through [`ImproveRun`]
+//! (implemented by the pipeline), which certifies whatever it changes, and
+//! [`crate::contract::improver`] checks it. How the two compare: paper-notes.md, Sec. 3.4.
 //!
 //! Files: `flips.rs` (connectivity update), `relocate.rs` (vertex position update),
 //! `geometry.rs` (the helpers they share), `eq5.rs` (Algorithm 2's planar updates),
@@ -34,7 +38,7 @@ mod relocate;
 mod registry;
 
 pub use algorithm2::{Algorithm2, ImproveOptions};
-pub use eq5::{Eq5Improver, Eq5Options, FlipRule, Target};
+pub use eq5::{Eq5Options, Eq5Updates, FlipRule, Target};
 pub use flips::connectivity_update;
 pub(crate) use geometry::point_triangle_distance;
 pub use registry::{improver, IMPROVERS};
@@ -126,20 +130,26 @@ pub struct RunError(pub Box<dyn std::error::Error + Send + Sync + 'static>);
 
 /// The research extension point of Sec. 3.4: an improvement of the working mesh after the
 /// loop of Algorithm 1. The run calls every improver of its stages' `improvers` list
-/// in order and reports the Table-1 row after each; whatever an improver changes goes through
-/// [`ImproveRun`], whose operations are certified, and the whole output is certified again
-/// after the last one.
+/// in order, giving each the run's own loop stages, and reports the Table-1 row after each;
+/// whatever an improver changes goes through [`ImproveRun`], whose operations are certified,
+/// and the whole output is certified again after the last one.
+///
+/// Contract ([`crate::contract::improver`]): it ends `Ok` on a run of the default stages,
+/// the output passes every certificate, and the same seed gives the same mesh.
 pub trait Improver: Send + Sync {
-    /// Short name used in reports (its registry row).
+    /// Short name used in reports: its registry row's name.
     fn name(&self) -> &'static str;
     /// Errors for option values no run can use, naming the option (checked before the loop
     /// of Algorithm 1 starts).
     fn validate(&self) -> Result<(), String> {
         Ok(())
     }
-    /// Improve the run's working mesh. Randomness only from `rng`.
+    /// Improve the run's working mesh; `stages` are the run's strategy, parameterizer and
+    /// planar remesher (for patches through [`ImproveRun::patch_pass`]). Randomness only
+    /// from `rng`.
     fn improve(
         &self,
+        stages: LoopStages<'_>,
         run: &mut dyn ImproveRun,
         rng: &mut crate::Rng,
     ) -> Result<ImproverCounts, RunError>;
@@ -227,6 +237,7 @@ impl Improver for SurfacePasses {
 
     fn improve(
         &self,
+        _stages: LoopStages<'_>,
         run: &mut dyn ImproveRun,
         _rng: &mut crate::Rng,
     ) -> Result<ImproverCounts, RunError> {

@@ -1,9 +1,21 @@
 //! The registry of improvers (Sec. 3.4): name → constructor and options. A new improver is a
-//! new file in `improve/` plus one row here. Unlike the other extension points a run takes a
-//! list of them, in order ([`crate::pipeline::Stages::improvers`]).
+//! new file in `improve/` plus one row here (or, outside the crate, one row given to a
+//! [`crate::registry::Registry`]). Unlike the other extension points a run takes a list of
+//! them, in order ([`crate::pipeline::Stages::improvers`]); the default list is every row of
+//! [`IMPROVERS`], in order.
 
 use super::{Algorithm2, FlipRule, ImproveOptions, Improver, SurfacePasses, Target};
-use crate::registry::{BadValue, Entry, OptionDoc, Params, RegistryError};
+use crate::registry::{optional, BadValue, Entry, MetricSizes, OptionDoc, Params, RegistryError};
+
+impl crate::registry::Stage for dyn Improver {
+    const KIND: &'static str = "improver";
+    fn builtin() -> &'static [Entry<Self>] {
+        IMPROVERS
+    }
+    fn stage_name(&self) -> &'static str {
+        self.name()
+    }
+}
 
 /// Every built-in improver, in the order the default list runs them.
 pub static IMPROVERS: &[Entry<dyn Improver>] = &[
@@ -13,62 +25,75 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
         options: &[
             OptionDoc {
                 name: "flips",
-                doc: "the connectivity update (edge flips by max-min q) [true]",
+                doc: "the connectivity update (edge flips by max-min q)",
+                default: |_| SurfacePasses::default().flips.to_string(),
             },
             OptionDoc {
                 name: "relocate",
-                doc: "the vertex position update, then flips again [true]",
+                doc: "the vertex position update, then flips again",
+                default: |_| SurfacePasses::default().relocate.to_string(),
             },
         ],
         build: surface,
     },
     Entry {
         name: "eq5",
-        summary: "Algorithm 2: cone patches around the faces below q, Eq. 5-6 updates in the plane (Sec. 3.4)",
+        summary: "Algorithm 2: patches of the run's strategy around the faces below q, the run's parameterizer, Eq. 5-6 updates in the plane (Sec. 3.4)",
         options: &[
             OptionDoc {
                 name: "q",
-                doc: "improve the faces whose metric quality is below this, in (0, 1] [0.5]",
+                doc: "improve the faces whose metric quality is below this, in (0, 1]",
+                default: |_| ImproveOptions::default().q_threshold.to_string(),
             },
             OptionDoc {
                 name: "angle",
-                doc: "and those whose smallest angle is below this (degrees, [0, 60)) [30]",
+                doc: "and those whose smallest angle is below this (degrees, [0, 60))",
+                default: |_| ImproveOptions::default().angle_threshold.to_string(),
             },
             OptionDoc {
                 name: "passes",
-                doc: "passes over the faces below q, each only if the last lowered their count [3]",
+                doc: "passes over the faces below q, each only if the last lowered their count",
+                default: |_| ImproveOptions::default().passes.to_string(),
             },
             OptionDoc {
                 name: "rings",
-                doc: "rings around a bad face in the first pass, one more per pass [2]",
+                doc: "rings around a bad face in the first pass, one more per pass",
+                default: |_| ImproveOptions::default().rings.to_string(),
             },
             OptionDoc {
                 name: "max_patches",
-                doc: "at most this many patches in all (then Ok with a warning) [no bound]",
+                doc: "at most this many patches in all (then Ok with a warning; none: no bound)",
+                default: |_| optional(ImproveOptions::default().max_patches),
             },
             OptionDoc {
                 name: "w",
-                doc: "the weight w of Eq. 5, > 0 [1]",
+                doc: "the weight w of Eq. 5, > 0",
+                default: |_| ImproveOptions::default().planar.w.to_string(),
             },
             OptionDoc {
                 name: "flips",
-                doc: "the flip rule: energy (Eq. 5) or max-min (q) [energy]",
+                doc: "the flip rule: energy (Eq. 5) or max-min (q)",
+                default: |_| flip_rule_name(ImproveOptions::default().planar.flip_rule).to_string(),
             },
             OptionDoc {
                 name: "target",
-                doc: "Eq. 5's equilateral triangle: own-area (shape only) or length (side L_tar, the paper's) [own-area]",
+                doc: "Eq. 5's equilateral triangle: own-area (shape only) or length (side L_tar, the paper's)",
+                default: |_| target_name(ImproveOptions::default().planar.target).to_string(),
             },
             OptionDoc {
                 name: "rounds",
-                doc: "rounds of (vertex update, flips) per patch [10]",
+                doc: "rounds of (vertex update, flips) per patch",
+                default: |_| ImproveOptions::default().planar.rounds.to_string(),
             },
             OptionDoc {
                 name: "steps",
-                doc: "gradient steps per vertex and round [4]",
+                doc: "gradient steps per vertex and round",
+                default: |_| ImproveOptions::default().planar.steps.to_string(),
             },
             OptionDoc {
                 name: "line_search",
-                doc: "halvings of a step's line search [12]",
+                doc: "halvings of a step's line search",
+                default: |_| ImproveOptions::default().planar.line_search.to_string(),
             },
             OptionDoc {
                 name: "collapse",
@@ -81,10 +106,26 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
 
 /// The improver of row `name` with `params` (see [`IMPROVERS`]).
 pub fn improver(name: &str, params: Params) -> Result<Box<dyn Improver>, RegistryError> {
-    crate::registry::build("improver", IMPROVERS, name, params)
+    crate::registry::build(IMPROVERS, name, params, MetricSizes::Relative)
 }
 
-fn surface(p: &mut Params) -> Result<Box<dyn Improver>, BadValue> {
+/// The option value of a flip rule.
+fn flip_rule_name(r: FlipRule) -> &'static str {
+    match r {
+        FlipRule::Energy => "energy",
+        FlipRule::MaxMin => "max-min",
+    }
+}
+
+/// The option value of an Eq. 5 target.
+fn target_name(t: Target) -> &'static str {
+    match t {
+        Target::OwnArea => "own-area",
+        Target::Length => "length",
+    }
+}
+
+fn surface(p: &mut Params, _: MetricSizes) -> Result<Box<dyn Improver>, BadValue> {
     let mut s = SurfacePasses::default();
     if let Some(b) = p.take("flips", "true or false")? {
         s.flips = b;
@@ -95,7 +136,7 @@ fn surface(p: &mut Params) -> Result<Box<dyn Improver>, BadValue> {
     Ok(Box::new(s))
 }
 
-fn eq5(p: &mut Params) -> Result<Box<dyn Improver>, BadValue> {
+fn eq5(p: &mut Params, _: MetricSizes) -> Result<Box<dyn Improver>, BadValue> {
     let mut o = ImproveOptions::default();
     if let Some(q) = p.take_checked("q", "a number in (0, 1]", |q: f64| q > 0.0 && q <= 1.0)? {
         o.q_threshold = q;
@@ -111,25 +152,25 @@ fn eq5(p: &mut Params) -> Result<Box<dyn Improver>, BadValue> {
     if let Some(r) = p.take_checked("rings", "a number of rings ≥ 1", |r: usize| r >= 1)? {
         o.rings = r;
     }
-    if let Some(m) = p.take("max_patches", "a number of patches")? {
-        o.max_patches = Some(m);
+    if let Some(m) = p.take_optional("max_patches", "a number of patches or none", |_: usize| {
+        true
+    })? {
+        o.max_patches = m;
     }
     if let Some(w) = p.take_checked("w", "a positive number", |w: f64| w.is_finite() && w > 0.0)? {
         o.planar.w = w;
     }
     if let Some(r) = p.take::<String>("flips", "energy or max-min")? {
-        o.planar.flip_rule = match r.as_str() {
-            "energy" => FlipRule::Energy,
-            "max-min" => FlipRule::MaxMin,
-            _ => return Err(BadValue::new("flips", &r, "energy or max-min")),
-        };
+        o.planar.flip_rule = [FlipRule::Energy, FlipRule::MaxMin]
+            .into_iter()
+            .find(|x| flip_rule_name(*x) == r)
+            .ok_or_else(|| BadValue::new("flips", &r, "energy or max-min"))?;
     }
     if let Some(t) = p.take::<String>("target", "own-area or length")? {
-        o.planar.target = match t.as_str() {
-            "own-area" => Target::OwnArea,
-            "length" => Target::Length,
-            _ => return Err(BadValue::new("target", &t, "own-area or length")),
-        };
+        o.planar.target = [Target::OwnArea, Target::Length]
+            .into_iter()
+            .find(|x| target_name(*x) == t)
+            .ok_or_else(|| BadValue::new("target", &t, "own-area or length"))?;
     }
     if let Some(n) = p.take("rounds", "a number of rounds")? {
         o.planar.rounds = n;

@@ -82,8 +82,10 @@ pub fn unprocessed_ring(ctx: &PatchContext<'_>, v: VertexId) -> Vec<FaceId> {
     ring
 }
 
-/// Turn a grown disk into a certified [`Patch`].
-pub(crate) fn finish_patch(
+/// Turn a grown disk into a certified [`Patch`] (the last step of a strategy's
+/// [`PatchStrategy::next_patch`]): its faces sorted, its boundary loop certified as a disk's,
+/// and the seed, cone and growth cost as given.
+pub fn finish_patch(
     disk: &DiskPatch<'_, '_>,
     ctx: &PatchContext<'_>,
     seed_vertex: VertexId,
@@ -137,6 +139,20 @@ pub struct ConePatches {
 impl PatchStrategy for ConePatches {
     fn name(&self) -> &'static str {
         "cone"
+    }
+
+    /// The same options with `rings` expansion rings, and no trimming of ragged expansions:
+    /// the trim is for Algorithm 1's combs of needles (paper-notes "Ragged expansions");
+    /// Algorithm 2's patches keep the rings around their bad faces whole, as they were
+    /// measured (paper-notes Sec. 3.4).
+    fn widened(&self, rings: usize) -> Option<Box<dyn PatchStrategy>> {
+        Some(Box::new(ConePatches {
+            options: ConeOptions {
+                expand_rings: rings,
+                trim_ragged: false,
+                ..self.options.clone()
+            },
+        }))
     }
 
     fn next_patch(

@@ -5,12 +5,15 @@
 //! unprocessed faces (ids in order within a ring) under the same exact disk rule, up to
 //! `rings` rings or `max_faces` faces, then expands into processed faces like the cone
 //! patches. No geometry is used: it shows what the cone criterion buys.
+//!
+//! The template of a strategy: it uses only public items (as a strategy written outside the
+//! crate would), and its registry row reads its defaults from [`KRingDisks::default`].
 
-use super::cone::{finish_patch, pick_seed_vertex, unprocessed_ring};
-use super::cone_fit::fit_cone;
-use super::expand::expand_rings;
-use super::grow::DiskPatch;
-use super::{Patch, PatchContext, PatchError, PatchStrategy};
+use crate::patches::expand::expand_rings;
+use crate::patches::{
+    finish_patch, fit_cone, pick_seed_vertex, unprocessed_ring, DiskPatch, Patch, PatchContext,
+    PatchError, PatchStrategy,
+};
 use rand_chacha::ChaCha8Rng;
 
 /// Geodesic k-ring disks.
@@ -37,6 +40,13 @@ impl Default for KRingDisks {
 impl PatchStrategy for KRingDisks {
     fn name(&self) -> &'static str {
         "kring"
+    }
+
+    fn widened(&self, rings: usize) -> Option<Box<dyn PatchStrategy>> {
+        Some(Box::new(KRingDisks {
+            expand_rings: rings,
+            ..self.clone()
+        }))
     }
 
     fn next_patch(

@@ -7,8 +7,10 @@
 //! covering run of `conemesh patches`).
 //!
 //! A new strategy: a file with a type implementing [`PatchStrategy`] (`kring.rs` is the
-//! template), one row in [`STRATEGIES`], and `cargo test` runs its contract
-//! ([`crate::contract::patch_strategy`]).
+//! template; the helpers it uses are public: [`pick_seed_vertex`], [`unprocessed_ring`],
+//! [`DiskPatch`], [`expand::expand_rings`], [`finish_patch`]), one row in [`STRATEGIES`], and
+//! `cargo test` runs its contract ([`crate::contract::patch_strategy`]). Outside the crate the
+//! row goes to a [`crate::registry::Registry`] instead.
 
 pub mod cone;
 pub mod cone_fit;
@@ -21,7 +23,7 @@ pub mod kring;
 mod registry;
 mod shrink;
 
-pub use cone::ConePatches;
+pub use cone::{finish_patch, pick_seed_vertex, unprocessed_ring, ConePatches};
 pub use cone_fit::{cone_error, cone_objective, fit_cone, fit_cone_normals};
 pub use cover::{cover, CoverOptions, CoverRun, PatchStats};
 pub use extract::{extract_patch, PatchMesh};
@@ -185,6 +187,14 @@ pub trait PatchStrategy: Send + Sync {
         target: usize,
     ) -> Vec<FaceId> {
         shrink_breadth_first(ctx, faces, seed_face, target)
+    }
+    /// The same strategy with its patches expanded by `rings` rings of processed faces after
+    /// growth: Algorithm 2 (Sec. 3.4) marks the good faces processed, so its patches are the
+    /// bad faces and `rings` rings around them, one ring more each pass. Default `None`: the
+    /// strategy has no such setting, and Algorithm 2 uses it as it is.
+    fn widened(&self, rings: usize) -> Option<Box<dyn PatchStrategy>> {
+        let _ = rings;
+        None
     }
 }
 /// A corner vertex all of whose faces are in `faces` (interior to the patch), if any.

@@ -207,7 +207,7 @@ pub fn run(
     for improver in improvers {
         let t = Instant::now();
         let counts = improver
-            .improve(&mut Host { ctx, state }, rng)
+            .improve(ctx.stages, &mut Host { ctx, state }, rng)
             .map_err(|e| match e.0.downcast::<PipelineError>() {
                 Ok(own) => *own,
                 Err(other) => PipelineError::Improver {

@@ -48,8 +48,9 @@ mod step;
 
 pub use error::{PipelineError, Stage, StageError};
 pub use options::{
-    default_improvers, Cancel, CoarseInput, RemeshOptions, Stages, TargetLength, COARSE_RATIO,
-    DEFAULT_BATCH, DEFAULT_IMPROVERS, DENSE_INPUT_RATIO, FACE_BUDGET, WORK_BUDGET,
+    default_improver_names, default_improvers, Cancel, Choice, CoarseInput, Registries,
+    RemeshOptions, Stages, TargetLength, COARSE_RATIO, DEFAULT_BATCH, DENSE_INPUT_RATIO,
+    FACE_BUDGET, WORK_BUDGET,
 };
 pub use records::{
     AngleSummary, Certificate, FailedAttempt, Fallbacks, ImprovementReport, ImproverRecord,

@@ -5,10 +5,10 @@ use crate::features::FeatureRule;
 use crate::fidelity::FidelityOptions;
 use crate::improve::Improver;
 use crate::metric::SizeOptions;
-use crate::param::{Parameterizer, SymmetricDirichlet};
-use crate::patches::{ConePatches, PatchStrategy};
-use crate::registry::{Params, RegistryError};
-use crate::remesh2d::{Lct, PlanarRemesher, TransferMethod};
+use crate::param::Parameterizer;
+use crate::patches::PatchStrategy;
+use crate::registry::{MetricSizes, Params, Registry, RegistryError};
+use crate::remesh2d::{PlanarRemesher, TransferMethod};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -271,7 +271,8 @@ impl RemeshOptions {
 
 /// The research extension points, with the paper's methods as defaults. Built by name from
 /// the registries ([`crate::patches::STRATEGIES`], [`crate::param::PARAMETERIZERS`],
-/// [`crate::remesh2d::REMESHERS`], [`crate::improve::IMPROVERS`]) or directly.
+/// [`crate::remesh2d::REMESHERS`], [`crate::improve::IMPROVERS`], or a [`Registries`] with
+/// rows of one's own) or directly.
 pub struct Stages {
     /// Sec. 3.2.
     pub patches: Box<dyn PatchStrategy>,
@@ -283,83 +284,98 @@ pub struct Stages {
     pub improvers: Vec<Box<dyn Improver>>,
 }
 
-/// The improvers a run takes by default, in order (their registry names).
-pub const DEFAULT_IMPROVERS: &[&str] = &["surface", "eq5"];
+/// The names of the improvers a run takes by default, in order: every row of
+/// [`crate::improve::IMPROVERS`].
+pub fn default_improver_names() -> Vec<&'static str> {
+    crate::registry::names(crate::improve::IMPROVERS)
+}
 
-/// The default improvers ([`DEFAULT_IMPROVERS`] from the registry, each with its default
-/// options; a test holds that every name builds).
+/// The default improvers: every row of [`crate::improve::IMPROVERS`] in order, each with its
+/// default options (a test holds that every row builds).
 pub fn default_improvers() -> Vec<Box<dyn Improver>> {
-    DEFAULT_IMPROVERS
+    crate::improve::IMPROVERS
         .iter()
-        .filter_map(|name| crate::improve::improver(name, Params::default()).ok())
+        .filter_map(|e| crate::improve::improver(e.name, Params::default()).ok())
         .collect()
 }
 
+/// One registry per extension point: the built-in rows ([`Registries::default`]) and any
+/// added with [`Registry::with`].
+#[derive(Default)]
+pub struct Registries {
+    /// Patch strategies.
+    pub strategies: Registry<dyn PatchStrategy>,
+    /// Parameterizers.
+    pub parameterizers: Registry<dyn Parameterizer>,
+    /// Planar remeshers.
+    pub remeshers: Registry<dyn PlanarRemesher>,
+    /// Improvers.
+    pub improvers: Registry<dyn Improver>,
+}
+
+/// A row chosen by name, with its `KEY=VALUE` options.
+pub type Choice<'a> = (&'a str, Params);
+
 impl Default for Stages {
+    /// The first row of each built-in table with its defaults, and every improver: the
+    /// paper's stages, for the curvature metric.
     fn default() -> Self {
-        Stages {
-            patches: Box::new(ConePatches::default()),
-            parameterizer: Box::new(SymmetricDirichlet::default()),
-            remesher: Box::new(Lct::default()),
-            improvers: default_improvers(),
-        }
+        Stages::for_sizes(MetricSizes::Relative)
     }
 }
 
 impl Stages {
-    /// The paper's stages set for absolute sizes (cone patches that trim ragged expansions,
-    /// [`crate::remesh2d::LctOptions::for_absolute_sizes`]): the default with a user metric.
-    pub fn for_user_metric() -> Stages {
+    /// The default stages for a metric with `sizes`: the first row of each built-in table with
+    /// its defaults for such a metric (with absolute sizes, cone patches that trim ragged
+    /// expansions and [`crate::remesh2d::LctOptions::for_absolute_sizes`]), and every
+    /// improver.
+    pub fn for_sizes(sizes: MetricSizes) -> Stages {
+        use crate::registry::build_default;
+        // The built-in tables' first rows build with their defaults for both kinds of sizes
+        // (the contract checks hold it, `contract::registry_row`).
+        const BUILDS: &str = "the first row of a built-in table builds with its defaults";
         Stages {
-            patches: Box::new(ConePatches {
-                options: crate::patches::ConeOptions {
-                    trim_ragged: true,
-                    ..Default::default()
-                },
-            }),
-            remesher: Box::new(Lct {
-                options: crate::remesh2d::LctOptions::for_absolute_sizes(),
-            }),
-            ..Stages::default()
+            patches: build_default(crate::patches::STRATEGIES, sizes).expect(BUILDS),
+            parameterizer: build_default(crate::param::PARAMETERIZERS, sizes).expect(BUILDS),
+            remesher: build_default(crate::remesh2d::REMESHERS, sizes).expect(BUILDS),
+            improvers: default_improvers(),
         }
     }
 
-    /// The stages of registry rows by name, each with its `KEY=VALUE` options, and the
-    /// default improvers (replace [`Stages::improvers`] to change them, e.g. with
-    /// [`crate::improve::improver`]). With a `user_metric`, a patch strategy or planar
-    /// remesher that has a `sizes` option gets `sizes=true` unless it is given (absolute
-    /// sizes; as [`Stages::for_user_metric`]).
+    /// The stages of built-in registry rows by name, each with its `KEY=VALUE` options, for a
+    /// metric with `sizes`, and the default improvers (replace [`Stages::improvers`] to change
+    /// them, e.g. with [`crate::improve::improver`]).
     pub fn from_registry(
-        strategy: (&str, Params),
-        parameterizer: (&str, Params),
-        remesher: (&str, Params),
-        user_metric: bool,
+        strategy: Choice<'_>,
+        parameterizer: Choice<'_>,
+        remesher: Choice<'_>,
+        sizes: MetricSizes,
     ) -> Result<Stages, RegistryError> {
-        let with_sizes = |table_names: &[(&str, bool)], (name, mut params): (&str, Params)| {
-            let declares = table_names.iter().any(|(n, has)| *n == name && *has);
-            if user_metric && declares && !params.contains("sizes") {
-                params.set("sizes", true);
-            }
-            (name.to_string(), params)
-        };
-        let declares =
-            |options: &[crate::registry::OptionDoc]| options.iter().any(|o| o.name == "sizes");
-        let strategies: Vec<(&str, bool)> = crate::patches::STRATEGIES
-            .iter()
-            .map(|e| (e.name, declares(e.options)))
-            .collect();
-        let remeshers: Vec<(&str, bool)> = crate::remesh2d::REMESHERS
-            .iter()
-            .map(|e| (e.name, declares(e.options)))
-            .collect();
-        let (sname, sparams) = with_sizes(&strategies, strategy);
-        let (rname, rparams) = with_sizes(&remeshers, remesher);
-        let strategy = (sname.as_str(), sparams);
-        let remesher = (rname.as_str(), rparams);
+        Stages::from_registries(
+            &Registries::default(),
+            strategy,
+            parameterizer,
+            remesher,
+            sizes,
+        )
+    }
+
+    /// [`Stages::from_registry`] from `registries` (which may hold rows of one's own).
+    pub fn from_registries(
+        registries: &Registries,
+        strategy: Choice<'_>,
+        parameterizer: Choice<'_>,
+        remesher: Choice<'_>,
+        sizes: MetricSizes,
+    ) -> Result<Stages, RegistryError> {
         Ok(Stages {
-            patches: crate::patches::strategy(strategy.0, strategy.1)?,
-            parameterizer: crate::param::parameterizer(parameterizer.0, parameterizer.1)?,
-            remesher: crate::remesh2d::planar_remesher(remesher.0, remesher.1)?,
+            patches: registries.strategies.build(strategy.0, strategy.1, sizes)?,
+            parameterizer: registries.parameterizers.build(
+                parameterizer.0,
+                parameterizer.1,
+                sizes,
+            )?,
+            remesher: registries.remeshers.build(remesher.0, remesher.1, sizes)?,
             improvers: default_improvers(),
         })
     }
@@ -397,10 +413,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_default_improvers_are_registry_rows_in_order() {
+    fn the_default_stages_are_the_first_rows_and_every_improver() {
         let built: Vec<_> = default_improvers().iter().map(|i| i.name()).collect();
-        assert_eq!(built, DEFAULT_IMPROVERS);
-        assert_eq!(Stages::default().improver_names(), DEFAULT_IMPROVERS);
+        assert_eq!(built, default_improver_names());
+        assert_eq!(Stages::default().improver_names(), default_improver_names());
+        for sizes in MetricSizes::ALL {
+            let s = Stages::for_sizes(sizes);
+            let firsts = [
+                crate::patches::STRATEGIES[0].name,
+                crate::param::PARAMETERIZERS[0].name,
+                crate::remesh2d::REMESHERS[0].name,
+            ];
+            assert_eq!(s.names(), firsts.map(String::from));
+        }
     }
 
     /// A stop asked from the progress callback ends the run after that patch, typed, and a

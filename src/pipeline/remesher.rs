@@ -35,8 +35,8 @@ pub const MAX_FACES_AT_VERTEX: usize = 16_384;
 pub struct Remesher {
     /// Options of Algorithm 1.
     pub options: RemeshOptions,
-    /// The extension points; `None`: the paper's methods, with the planar remesher set for
-    /// absolute sizes when a user metric is given ([`Stages::for_user_metric`]).
+    /// The extension points; `None`: the paper's methods, set for absolute sizes when a user
+    /// metric is given ([`Stages::for_sizes`]).
     pub stages: Option<Stages>,
     /// How the curvature metric is estimated (when no user metric is given).
     pub metric: MetricOptions,
@@ -184,14 +184,11 @@ impl Remesher {
         options.sizes.hmin = options.sizes.hmin.map(|h| h * norm.scale);
         options.sizes.hmax = options.sizes.hmax.map(|h| h * norm.scale);
         let defaults;
-        let stages = match (&self.stages, metric.is_some()) {
-            (Some(s), _) => s,
-            (None, user) => {
-                defaults = if user {
-                    Stages::for_user_metric()
-                } else {
-                    Stages::default()
-                };
+        let stages = match &self.stages {
+            Some(s) => s,
+            None => {
+                let sizes = crate::registry::MetricSizes::of_user_metric(metric.is_some());
+                defaults = Stages::for_sizes(sizes);
                 &defaults
             }
         };
