@@ -97,7 +97,8 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
             },
             OptionDoc {
                 name: "collapse",
-                doc: "collapse the shortest edge of a triangle whose smallest angle is below this (degrees, [0, 60); 0: none) when that raises the smallest angle around it [30]",
+                doc: "collapse the shortest edge of a triangle whose smallest angle is below this (degrees, [0, 60); 0: none) when that raises the smallest angle around it",
+                default: |_| ImproveOptions::default().planar.collapse_below_deg.to_string(),
             },
         ],
         build: eq5,
