@@ -13,12 +13,15 @@
 //!   [`remesh2d::PlanarRemesher`] registry.
 //! - [`lift`], [`stitch`]: Sec. 3.3 "Mapping back", replacing a patch.
 //! - [`fidelity`]: the distance control of a patch (ours).
-//! - [`pipeline`]: Algorithm 1, and [`pipeline::Remesher`], the whole job from file units.
+//! - [`pipeline`]: Algorithm 1, and [`pipeline::Remesher`], the same from file units.
+//! - [`job`]: the whole job of `conemesh remesh` and the Python package: repair, Algorithm 1,
+//!   the yardstick, the report and the files; the arguments both front ends parse.
 //! - [`improve`]: Sec. 3.4, connectivity and vertex position updates on the surface, and
 //!   Algorithm 2's planar updates (Eq. 5-6).
 //! - [`quality`], [`report`]: Sec. 4.1, the yardstick; JSON and plots.
 //! - [`render`]: pictures of a surface coloured by q, angle, patch or distance (Fig. 3, 6).
 //! - [`registry`], [`contract`]: the extension points' tables and their contract checks.
+//! - [`option_error`]: an option value no run can use, named with its value and range.
 //! - [`boundary`]: the input's boundary curves the output's boundary lies on (ours).
 //! - [`suite`]: the analytic benchmark cases (surfaces with user-style metrics).
 //! - [`compare`]: comparisons of configurations over inputs × seeds, their statistics and
@@ -35,9 +38,11 @@ pub mod ids;
 pub mod improve;
 pub mod invariants;
 pub mod io;
+pub mod job;
 pub mod lift;
 pub mod mesh;
 pub mod metric;
+pub mod option_error;
 pub mod param;
 pub mod patches;
 pub mod pipeline;

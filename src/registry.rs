@@ -60,8 +60,11 @@ pub enum RegistryError {
         expected: &'static str,
     },
     /// An option not written `KEY=VALUE`.
-    #[error("option `{0}` is not of the form KEY=VALUE")]
-    Malformed(String),
+    #[error("option `{item}` is not of the form KEY=VALUE")]
+    Malformed {
+        /// the text given
+        item: String,
+    },
     /// A row whose constructor built an implementation of another name (`name()` must be
     /// the row's name: reports and `--improver-opt NAME.KEY` go by it).
     #[error("{kind} row `{row}` built an implementation named `{built}`")]
@@ -175,7 +178,9 @@ impl Params {
             let (k, v) = item
                 .split_once('=')
                 .filter(|(k, _)| !k.trim().is_empty())
-                .ok_or_else(|| RegistryError::Malformed(item.to_string()))?;
+                .ok_or_else(|| RegistryError::Malformed {
+                    item: item.to_string(),
+                })?;
             given.insert(k.trim().to_string(), v.trim().to_string());
         }
         Ok(Params { given })
@@ -459,7 +464,9 @@ mod tests {
         }
         assert_eq!(
             Params::parse(&["times"]),
-            Err(RegistryError::Malformed("times".into()))
+            Err(RegistryError::Malformed {
+                item: "times".into()
+            })
         );
         // A row added to a registry builds by name; a second row of the same name is refused.
         static CROW: Entry<dyn Speak> = Entry {
@@ -487,7 +494,7 @@ mod tests {
         ));
         assert_eq!(
             Params::parse(&["=3"]),
-            Err(RegistryError::Malformed("=3".into()))
+            Err(RegistryError::Malformed { item: "=3".into() })
         );
     }
 }

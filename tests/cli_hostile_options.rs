@@ -328,6 +328,9 @@ fn a_disk_read_as_one_polygon_of_100000_corners_is_refused_by_name_with_no_outpu
         "--report",
         report.to_str().expect("utf-8"),
     ]);
-    refused(&o, "input vertex v0 is a corner of 99998 faces (at most 16384)");
+    refused(
+        &o,
+        "input vertex v0 is a corner of 99998 faces (at most 16384)",
+    );
     assert!(!out.exists() && !report.exists());
 }

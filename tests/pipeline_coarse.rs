@@ -162,8 +162,8 @@ fn a_target_too_small_for_the_input_is_refused_up_front() {
         ..RemeshOptions::default()
     };
     match remesh(&f, &Stages::default(), &o, |_| {}) {
-        Err(conemesh::pipeline::PipelineError::Input(msg)) => {
-            assert!(msg.contains("too small") && msg.contains("faces"), "{msg}")
+        Err(conemesh::pipeline::PipelineError::TargetTooSmall { expected, max, .. }) => {
+            assert!(expected > max, "{expected} faces, at most {max}")
         }
         other => panic!("expected an input error, got {:?}", other.map(|_| ())),
     }

@@ -7,6 +7,7 @@
 use conemesh::features::sharp_edges;
 use conemesh::mesh::SurfaceProjector;
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
+use conemesh::option_error::OptionError;
 use conemesh::patches::{Patch, PatchContext, PatchError, PatchStrategy};
 use conemesh::pipeline::{remesh, PipelineError, RemeshOptions, Stages};
 use conemesh::quality::{evaluate, EvalOptions};
@@ -122,7 +123,9 @@ fn a_bad_feature_angle_is_refused() {
             ..RemeshOptions::default()
         };
         match remesh(&f, &Stages::default(), &o, |_| {}) {
-            Err(PipelineError::Input(msg)) => assert!(msg.contains("feature angle"), "{msg}"),
+            Err(PipelineError::Option(OptionError::OutOfRange { option, .. })) => {
+                assert_eq!(option, "feature angle")
+            }
             other => panic!(
                 "{bad}: expected an input error, got {:?}",
                 other.map(|_| ())
@@ -263,11 +266,9 @@ fn a_tiny_target_with_feature_lines_is_an_input_error() {
         ..RemeshOptions::default()
     };
     match remesh(&f, &Stages::default(), &o, |_| {}) {
-        Err(PipelineError::Input(msg)) => {
-            // The run's size check (`MAX_EXPECTED_FACES`) refuses it before the feature split
-            // and its own bound (`features::MAX_NEW_VERTICES`) are reached.
-            assert!(msg.contains("too small"), "{msg}")
-        }
+        // The run's size check (`MAX_EXPECTED_FACES`) refuses it before the feature split and
+        // its own bound (`features::MAX_NEW_VERTICES`) are reached.
+        Err(PipelineError::TargetTooSmall { l_tar, .. }) => assert_eq!(l_tar, 1e-20),
         other => panic!("expected an input error, got {:?}", other.map(|_| ())),
     }
 }

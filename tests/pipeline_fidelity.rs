@@ -99,6 +99,17 @@ fn a_negative_or_nan_tolerance_is_refused() {
         let Err(err) = remesh(&field, &Stages::default(), &options, |_| {}) else {
             panic!("tolerance {eps} accepted");
         };
-        assert!(err.to_string().contains("fidelity tolerance"), "{err}");
+        assert!(
+            matches!(
+                err,
+                conemesh::pipeline::PipelineError::Option(
+                    conemesh::option_error::OptionError::OutOfRange {
+                        option: "fidelity tolerance",
+                        ..
+                    }
+                )
+            ),
+            "{err}"
+        );
     }
 }

@@ -174,7 +174,16 @@ fn an_improver_from_outside_the_crate_runs_certified_and_its_refusals_keep_the_m
         })
         .run(&input);
     assert!(
-        matches!(&bad, Err(e) if e.to_string().contains("eq5") && e.to_string().contains("rings")),
+        matches!(
+            &bad,
+            Err(conemesh::pipeline::PipelineError::ImproverOption {
+                improver: "eq5",
+                source: conemesh::option_error::OptionError::TooFew {
+                    option: "improvement rings",
+                    ..
+                },
+            })
+        ),
         "{:?}",
         bad.err()
     );

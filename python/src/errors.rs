@@ -145,7 +145,21 @@ pub fn with_invariant(f: Failure, e: &InvariantError) -> Failure {
             "boundary_corners_lost",
             f.with("vertices", ids(&o.0, |v| v.0 as i64)),
         ),
-        I::NotADisk { .. } => ("not_a_disk", f),
+        I::NotADisk(d) => {
+            let f = match d.vertices().as_slice() {
+                [] => f,
+                v => f.with("vertices", ids(v, |x| x.0 as i64)),
+            };
+            let f = match d.faces().as_slice() {
+                [] => f,
+                v => f.with("faces", ids(v, |x| x.0 as i64)),
+            };
+            let f = match d.edges().as_slice() {
+                [] => f,
+                v => f.with("edges", Attr::Pairs(v.iter().map(edge).collect())),
+            };
+            ("not_a_disk", f)
+        }
         I::NotBijective { .. } => ("not_bijective", f),
         I::FlippedFaces(o) => ("flipped_faces", f.with("faces", ids(&o.0, |x| x.0 as i64))),
         I::PlanarInvalid { .. } => ("planar_invalid", f),
@@ -240,7 +254,17 @@ pub fn from_pipeline(e: &PipelineError) -> Failure {
             message: msg,
             ..from_metric(m)
         },
-        PipelineError::Input(_) => Failure::input(msg),
+        PipelineError::NotManifold(inv) => with_invariant(Failure::input(msg), inv),
+        PipelineError::SizedMetric(m) | PipelineError::FidelityMetric(m) => Failure {
+            message: msg,
+            ..from_metric(m)
+        },
+        PipelineError::MetricCount { .. } => Failure::new("MetricError", msg),
+        PipelineError::Option(_) | PipelineError::ImproverOption { .. } => Failure::option(msg),
+        PipelineError::EmptyInput
+        | PipelineError::BadTarget { .. }
+        | PipelineError::TargetTooSmall { .. }
+        | PipelineError::Features(_) => Failure::input(msg),
         PipelineError::CrowdedVertex { vertex, .. } => {
             Failure::input(msg).with("vertices", Attr::Ints(vec![vertex.0 as i64]))
         }

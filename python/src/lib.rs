@@ -2,14 +2,15 @@
 //! functions, their numpydoc and the keyword handling are in `conemesh/__init__.py`; this
 //! module takes checked numpy arrays and CLI-style argument lists and calls the library.
 //!
-//! `remesh` keywords become `conemesh remesh` flags, parsed by the CLI's own clap
-//! definitions and turned into options by the CLI's own builders (`src/cli/remesh.rs`,
-//! compiled here too), so a keyword's default is the flag's default by construction.
-//! Work runs with the GIL released; Ctrl-C is seen after each patch and stops the run
-//! through [`conemesh::pipeline::Cancel`].
+//! `remesh` keywords become `conemesh remesh` flags, parsed by the library's one clap
+//! definition of them ([`conemesh::job::RemeshArgs`], which the CLI parses too) and run as
+//! the library's job ([`conemesh::job`]), so a keyword's default is the flag's default and
+//! the output is the CLI's by construction. Work runs with the GIL released; Ctrl-C is seen
+//! after each patch and stops the run through [`conemesh::pipeline::Cancel`].
 
 use clap::{ArgAction, CommandFactory, Parser};
-use conemesh::pipeline::{PipelineError, Progress, Remesher};
+use conemesh::job::{JobError, JobInput, ProgressBar, RemeshArgs, Source};
+use conemesh::pipeline::{PipelineError, Progress};
 use conemesh::quality::{EvalOptions, TargetLength};
 use conemesh::{TriMesh, VertexId};
 use errors::{Attr, Failure};
@@ -25,25 +26,12 @@ use std::time::Instant;
 
 mod errors;
 
-// The path checks and the output commit `remesh.rs` calls as `super::…`.
-#[allow(dead_code)]
-#[path = "../../src/cli/outputs.rs"]
-mod cli_outputs;
-#[allow(unused_imports)]
-use cli_outputs::{check_file_output, check_plots_folder, commit, same_path};
-
-// Only the argument struct and the option builders are used here; `run` and the path
-// checks are the CLI's own.
-#[allow(dead_code)]
-#[path = "../../src/cli/remesh.rs"]
-mod cli_remesh;
-
 /// `conemesh remesh`'s arguments as their own command, as `src/main.rs` declares it.
 #[derive(Parser, Debug)]
 #[command(name = "conemesh remesh", allow_negative_numbers = true)]
 struct RemeshCli {
     #[command(flatten)]
-    args: cli_remesh::RemeshArgs,
+    args: RemeshArgs,
 }
 
 type PyResultOf<T> = Result<T, Failure>;
@@ -253,7 +241,7 @@ fn remesh_options(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
 
 /// clap's verdict on an argument list, in the keywords' words (`ltar_factor`, not
 /// `--ltar-factor <LTAR_FACTOR>`).
-fn parse_args(args: &[String]) -> PyResultOf<cli_remesh::RemeshArgs> {
+fn parse_args(args: &[String]) -> PyResultOf<RemeshArgs> {
     let argv = std::iter::once("conemesh remesh".to_string()).chain(args.iter().cloned());
     RemeshCli::try_parse_from(argv)
         .map(|c| c.args)
@@ -305,15 +293,27 @@ struct Remeshed {
     report: String,
 }
 
-/// The whole of `conemesh remesh` on arrays: the same options, stages, run and yardstick,
-/// so that the output mesh is the CLI's byte for byte for the same seed.
+/// An error and its sources, as `anyhow`'s `{:#}` prints them (`a: b: c`).
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut out = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        out.push_str(": ");
+        out.push_str(&s.to_string());
+        source = s.source();
+    }
+    out
+}
+
+/// The whole of `conemesh remesh` on arrays: the library's job with the same arguments, so
+/// that the output mesh is the CLI's byte for byte for the same seed.
 fn remesh_job(
-    args: &cli_remesh::RemeshArgs,
-    mesh: &TriMesh,
-    metric: Option<&[Matrix3<f64>]>,
+    args: &RemeshArgs,
+    mesh: TriMesh,
+    metric: Option<Vec<Matrix3<f64>>>,
     mut on_progress: impl FnMut(Progress) -> bool,
 ) -> PyResultOf<Remeshed> {
-    let t_start = Instant::now();
+    let started = Instant::now();
     if let Some(n) = args.threads {
         // The CLI sizes the process's one rayon pool at start; a Python process may already
         // have used it.
@@ -322,38 +322,31 @@ fn remesh_job(
         )));
     }
     // The output paths first, as the CLI checks them: a bad path costs no remesh.
-    cli_remesh::check_output_paths(args, false)
-        .map_err(|e| Failure::new("FileError", keywordify(&format!("{e:#}"))))?;
-    // Without `repair=True` the caller's arrays are used as they are (no copy).
-    let repaired = match args.repair {
-        false => None,
-        true => Some(
-            cli_remesh::repaired_input(
-                args,
-                mesh.clone(),
-                metric.map(<[_]>::to_vec),
-                "the input",
-                Vec::new(),
-            )
-            .map_err(
-                |e| match e.downcast_ref::<conemesh::repair::RepairError>() {
-                    Some(conemesh::repair::RepairError::Unrepaired(v)) => {
-                        errors::with_invariant(Failure::input(format!("{e:#}")), v)
-                    }
-                    _ => Failure::input(format!("{e:#}")),
-                },
-            )?,
-        ),
+    args.check_output_paths(false)
+        .map_err(|e| Failure::new("FileError", keywordify(&e.to_string())))?;
+    let input = JobInput {
+        mesh,
+        metric,
+        repeated_index_faces: Vec::new(),
+        started,
     };
-    let (mesh, metric, repair) = match &repaired {
-        Some(r) => (&r.mesh, r.metric.as_deref(), r.repair.as_ref()),
-        None => (mesh, metric, None),
-    };
+    let prepared = input.prepare(args.repair_options().as_ref()).map_err(|e| {
+        let message = format!("repairing the input: {}", chain(&e));
+        match &e {
+            conemesh::repair::RepairError::Unrepaired(v) => {
+                errors::with_invariant(Failure::input(message), v)
+            }
+            _ => Failure::input(message),
+        }
+    })?;
+    if let Some(log) = &prepared.repair {
+        eprintln!("repair: {}", log.summary());
+    }
     // The pipeline refuses a non-manifold input with a message; certify it here first so
     // that the exception names the elements, in the caller's numbering.
-    let topo = conemesh::Topology::build(mesh);
-    conemesh::invariants::certify_manifold(mesh, &topo)
-        .and_then(|()| conemesh::invariants::certify_oriented(mesh, &topo))
+    let topo = conemesh::Topology::build(&prepared.mesh);
+    conemesh::invariants::certify_manifold(&prepared.mesh, &topo)
+        .and_then(|()| conemesh::invariants::certify_oriented(&prepared.mesh, &topo))
         .map_err(|e| {
             errors::with_invariant(
                 Failure::input(format!(
@@ -362,58 +355,39 @@ fn remesh_job(
                 &e,
             )
         })?;
-    let mut options = cli_remesh::options(args);
+    let mut job = args
+        .job(prepared.metric.is_some())
+        .map_err(|e| Failure::option(chain(&e)))?;
     // The CLI writes offending patches beside its output; an array has no such folder.
-    options.debug_dir = args.debug_dir.clone();
-    let cancel = options.cancel.clone();
-    let stages = cli_remesh::stages(args, metric.is_some())
-        .map_err(|e| Failure::option(format!("{e:#}")))?;
-    let bar = cli_remesh::progress_bar(args.quiet, mesh.n_faces() as u64);
-    let result =
-        Remesher::new(options)
-            .with_stages(stages)
-            .run_with(mesh, metric, |p: Progress| {
-                bar.set_length(p.total as u64);
-                bar.set_position((p.total - p.unprocessed) as u64);
-                bar.set_message(format!("{} patches", p.patches));
-                if !on_progress(p) {
-                    cancel.cancel();
-                }
-            });
-    bar.finish_and_clear();
-    let out = result.map_err(|e| match e {
-        PipelineError::Cancelled { patches } => Failure::new(
+    job.remesher.options.debug_dir = args.debug_dir.clone();
+    let cancel = job.remesher.options.cancel.clone();
+    let bar = ProgressBar::new(args.quiet, prepared.mesh.n_faces());
+    let result = job.remesh(prepared, |p: Progress| {
+        bar.show(p);
+        if !on_progress(p) {
+            cancel.cancel();
+        }
+    });
+    bar.finish();
+    let outcome = result.map_err(|e| match e {
+        JobError::Remesh(PipelineError::Cancelled { patches }) => Failure::new(
             "KeyboardInterrupt",
             format!("remesh cancelled after {patches} patches"),
         ),
-        e => errors::from_pipeline(&e),
+        JobError::Remesh(e) => errors::from_pipeline(&e),
+        e => Failure::new("RemeshError", e.to_string()),
     })?;
-    let elapsed = t_start.elapsed().as_secs_f64();
-    // The yardstick of `conemesh remesh`, with its options.
-    let eval = cli_remesh::evaluate_output(args, &out)
-        .map_err(|e| Failure::new("RemeshError", e.to_string()))?;
-    let r = &out.unit.report;
-    // The CLI's `--report` document, with the Table-1 line added.
-    let json = serde_json::json!({
-        "input": null,
-        "output": null,
-        "seconds": elapsed,
-        "peak_rss_mib": cli_remesh::peak_rss_mib(),
-        "repair": repair,
-        "run": r,
-        "eval": eval,
-        "table_header": conemesh::quality::EvalReport::table_header(),
-        "table_row": eval.table_row("remesh"),
-    });
+    // The files asked for, as one transaction (the CLI's): all or none. The report is the
+    // CLI's `--report` document, with the Table-1 line added.
+    let mut outputs = conemesh::io::Outputs::new();
+    let json = outcome
+        .stage_files(&mut outputs, &args.files(false), &Source::Arrays)
+        .map_err(|e| Failure::new("FileError", chain(&e)))?;
+    conemesh::io::paths::commit(outputs).map_err(|e| Failure::new("FileError", chain(&e)))?;
     let report =
         serde_json::to_string(&json).map_err(|e| Failure::new("RemeshError", e.to_string()))?;
-    // The files asked for, as one transaction (the CLI's `Outputs`): all or none.
-    let mut outputs = conemesh::io::Outputs::new();
-    cli_remesh::stage_side_outputs(&mut outputs, args, &out, &eval, &json, "remesh")
-        .and_then(|()| cli_outputs::commit(outputs))
-        .map_err(|e| Failure::new("FileError", format!("{e:#}")))?;
     Ok(Remeshed {
-        mesh: out.mesh,
+        mesh: outcome.remeshed.mesh,
         report,
     })
 }
@@ -434,7 +408,7 @@ fn remesh<'py>(
     let metric = raise(py, metric_of(metric_array, metric_path, mesh.n_vertices()))?;
     let mut interrupt: Option<PyErr> = None;
     let result = py.detach(|| {
-        remesh_job(&parsed, &mesh, metric.as_deref(), |_| {
+        remesh_job(&parsed, mesh, metric, |_| {
             // Signals are Python's to deliver: take the GIL for a moment after each patch.
             match Python::attach(|py| py.check_signals()) {
                 Ok(()) => true,
@@ -695,7 +669,7 @@ fn render<'py>(
     };
     let color = raise(
         py,
-        ColorBy::parse(&color).map_err(|e| Failure::option(format!("color: {e}"))),
+        ColorBy::parse(&color).map_err(|e| Failure::option(e.to_string())),
     )?;
     let wireframe = raise(
         py,

@@ -11,5 +11,4 @@ pub mod remesh;
 pub mod render;
 pub mod stages;
 
-mod outputs;
-pub use outputs::{check_file_output, check_plots_folder, commit, same_path};
+pub use conemesh::io::paths::{check_file_output, check_plots_folder, commit, same_path};

@@ -42,9 +42,9 @@ impl Config {
         })?;
         Config::new(
             name.trim(),
-            split_args(args).map_err(|detail| CompareError::Config {
+            split_args(args).map_err(|e| CompareError::Config {
                 what: spec.to_string(),
-                detail,
+                detail: e.to_string(),
             })?,
         )
     }
@@ -82,8 +82,18 @@ impl Config {
     }
 }
 
+/// An argument line whose quote is not closed.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unclosed quote {quote} in `{line}`")]
+pub struct UnclosedQuote {
+    /// the quote character
+    pub quote: char,
+    /// the line
+    pub line: String,
+}
+
 /// Split `s` at white space, keeping quoted stretches (`'…'` or `"…"`) in one argument.
-pub fn split_args(s: &str) -> Result<Vec<String>, String> {
+pub fn split_args(s: &str) -> Result<Vec<String>, UnclosedQuote> {
     let mut out = Vec::new();
     let mut cur: Option<String> = None;
     let mut quote: Option<char> = None;
@@ -100,7 +110,10 @@ pub fn split_args(s: &str) -> Result<Vec<String>, String> {
         }
     }
     if let Some(q) = quote {
-        return Err(format!("unclosed quote {q} in `{s}`"));
+        return Err(UnclosedQuote {
+            quote: q,
+            line: s.to_string(),
+        });
     }
     out.extend(cur);
     Ok(out)
@@ -185,9 +198,9 @@ pub fn read_config_file(path: &Path) -> Result<Vec<Config>, CompareError> {
         .map(|e| {
             let args = match e.args {
                 Args::None => Vec::new(),
-                Args::Line(s) => split_args(&s).map_err(|detail| CompareError::ConfigFile {
+                Args::Line(s) => split_args(&s).map_err(|e| CompareError::ConfigFile {
                     path: file.clone(),
-                    detail,
+                    detail: e.to_string(),
                 })?,
                 Args::List(l) => l,
             };
@@ -320,7 +333,13 @@ mod tests {
         assert!(Config::parse("a/b=--sweeps 2").is_err());
         let own = Config::parse("x=--seed 3").unwrap_err().to_string();
         assert!(own.contains("--seed"), "{own}");
-        assert!(split_args("'open").is_err());
+        assert_eq!(
+            split_args("'open"),
+            Err(UnclosedQuote {
+                quote: '\'',
+                line: "'open".into()
+            })
+        );
         let twice = [
             Config::parse("a=").expect("no args"),
             Config::parse("a=--sweeps 1").expect("one option"),

@@ -289,7 +289,7 @@ impl Grid {
                         }
                         Err(e) => {
                             rec.status = Status::Crashed;
-                            rec.error = e;
+                            rec.error = e.to_string();
                         }
                     }
                 } else {
@@ -356,15 +356,21 @@ fn render_available(exe: &Path, timeout: Duration) -> Result<(), String> {
 }
 
 /// The output's SHA-256 and the report's numbers.
-fn read_result(dir: &Path, files: &RunFiles) -> Result<(String, RunResult), String> {
+fn read_result(dir: &Path, files: &RunFiles) -> Result<(String, RunResult), super::CompareError> {
+    let os = |path: &Path| {
+        let path = path.display().to_string();
+        move |source| super::CompareError::Os { path, source }
+    };
     let out = dir.join(&files.output);
-    let sha = sha256_file(&out).map_err(|e| format!("reading {}: {e}", out.display()))?;
+    let sha = sha256_file(&out).map_err(os(&out))?;
     let report = dir.join(&files.report);
-    let text = std::fs::read_to_string(&report)
-        .map_err(|e| format!("reading {}: {e}", report.display()))?;
+    let text = std::fs::read_to_string(&report).map_err(os(&report))?;
     let json: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", report.display()))?;
-    let result = RunResult::from_report(&json, &files.report).map_err(|e| e.to_string())?;
+        serde_json::from_str(&text).map_err(|e| super::CompareError::Report {
+            path: report.display().to_string(),
+            detail: e.to_string(),
+        })?;
+    let result = RunResult::from_report(&json, &files.report)?;
     Ok((sha, result))
 }
 

@@ -17,6 +17,7 @@
 
 use crate::ids::{EdgeKey, FaceId, VertexId};
 use crate::mesh::{SurfaceLocation, Topology, TriMesh};
+use crate::option_error::OptionError;
 use crate::stitch::WorkingMesh;
 use nalgebra::Point3;
 use std::collections::{HashMap, HashSet};
@@ -90,14 +91,16 @@ impl FeatureRule {
     }
 
     /// Reads `auto`, `off` (or `0`) or an angle in degrees, as `--feature-angle` takes it.
-    pub fn parse(s: &str) -> Result<FeatureRule, String> {
+    pub fn parse(s: &str) -> Result<FeatureRule, OptionError> {
         match s.trim() {
             "auto" => Ok(FeatureRule::Auto),
             "off" => Ok(FeatureRule::Off),
             t => {
-                let a: f64 = t
-                    .parse()
-                    .map_err(|_| format!("expected auto, off or an angle in degrees, got {t:?}"))?;
+                let a: f64 = t.parse().map_err(|_| OptionError::Unparsed {
+                    option: "feature angle",
+                    value: t.to_string(),
+                    expected: "auto, off or an angle in degrees",
+                })?;
                 let rule = match a == 0.0 {
                     true => FeatureRule::Off,
                     false => FeatureRule::Angle(a),
@@ -109,11 +112,13 @@ impl FeatureRule {
     }
 
     /// Checks the angle (in (0, 180) degrees).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), OptionError> {
         match *self {
-            FeatureRule::Angle(a) if !(a > 0.0 && a < 180.0) => Err(format!(
-                "feature angle must be between 0 and 180 degrees (exclusive), got {a}"
-            )),
+            FeatureRule::Angle(a) if !(a > 0.0 && a < 180.0) => Err(OptionError::OutOfRange {
+                option: "feature angle",
+                value: a,
+                range: "between 0 and 180 degrees (exclusive)",
+            }),
             _ => Ok(()),
         }
     }
@@ -601,7 +606,14 @@ mod tests {
         assert_eq!(FeatureRule::parse("auto"), Ok(FeatureRule::Auto));
         assert_eq!(FeatureRule::parse("0"), Ok(FeatureRule::Off));
         assert_eq!(FeatureRule::parse("30"), Ok(FeatureRule::Angle(30.0)));
-        assert!(FeatureRule::parse("-5").is_err() && FeatureRule::parse("x").is_err());
+        assert!(matches!(
+            FeatureRule::parse("-5"),
+            Err(OptionError::OutOfRange { value, .. }) if value == -5.0
+        ));
+        assert!(matches!(
+            FeatureRule::parse("x"),
+            Err(OptionError::Unparsed { .. })
+        ));
     }
 
     /// The chain filter of the automatic rule on hand-made lines over a 20×20 plate: long

@@ -22,6 +22,7 @@
 
 use super::{Eq5Options, Eq5Updates, ImproveRun, Improver, ImproverCounts};
 use super::{LoopStages, RunError};
+use crate::option_error::OptionError;
 use crate::quality::TriangleQuality;
 use serde::Serialize;
 
@@ -65,23 +66,31 @@ impl Default for ImproveOptions {
 
 impl ImproveOptions {
     /// Errors for values no run can use, naming the option.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), OptionError> {
+        let out_of_range = |option, value, range| OptionError::OutOfRange {
+            option,
+            value,
+            range,
+        };
         let q = self.q_threshold;
         if !(q.is_finite() && q > 0.0 && q <= 1.0) {
-            return Err(format!("improvement threshold must be in (0, 1], got {q}"));
+            return Err(out_of_range("improvement threshold", q, "in (0, 1]"));
         }
         let a = self.angle_threshold;
         if !(a.is_finite() && (0.0..60.0).contains(&a)) {
-            return Err(format!(
-                "improvement angle threshold must be in [0°, 60°), got {a}"
-            ));
+            let range = "in [0°, 60°)";
+            return Err(out_of_range("improvement angle threshold", a, range));
         }
         let w = self.planar.w;
         if !(w.is_finite() && w > 0.0) {
-            return Err(format!("Eq. 5 weight w must be a positive number, got {w}"));
+            return Err(out_of_range("Eq. 5 weight w", w, "a positive number"));
         }
         if self.rings == 0 {
-            return Err("improvement rings must be at least 1".into());
+            return Err(OptionError::TooFew {
+                option: "improvement rings",
+                value: 0,
+                min: 1,
+            });
         }
         Ok(())
     }
@@ -106,7 +115,7 @@ impl Improver for Algorithm2 {
         "eq5"
     }
 
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), OptionError> {
         self.options.validate()
     }
 
@@ -190,14 +199,19 @@ mod tests {
         let bad = |f: fn(&mut ImproveOptions)| {
             let mut o = ImproveOptions::default();
             f(&mut o);
-            o.validate().expect_err("refused")
+            match o.validate().expect_err("refused") {
+                OptionError::OutOfRange { option, .. } | OptionError::TooFew { option, .. } => {
+                    option
+                }
+                other => panic!("{other}"),
+            }
         };
-        assert!(bad(|i| i.q_threshold = 0.0).contains("threshold"));
-        assert!(bad(|i| i.q_threshold = f64::NAN).contains("threshold"));
-        assert!(bad(|i| i.q_threshold = 1.5).contains("threshold"));
-        assert!(bad(|i| i.planar.w = -1.0).contains("weight w"));
-        assert!(bad(|i| i.planar.w = f64::INFINITY).contains("weight w"));
-        assert!(bad(|i| i.rings = 0).contains("rings"));
+        assert_eq!(bad(|i| i.q_threshold = 0.0), "improvement threshold");
+        assert_eq!(bad(|i| i.q_threshold = f64::NAN), "improvement threshold");
+        assert_eq!(bad(|i| i.q_threshold = 1.5), "improvement threshold");
+        assert_eq!(bad(|i| i.planar.w = -1.0), "Eq. 5 weight w");
+        assert_eq!(bad(|i| i.planar.w = f64::INFINITY), "Eq. 5 weight w");
+        assert_eq!(bad(|i| i.rings = 0), "improvement rings");
         assert!(ImproveOptions::default().validate().is_ok());
     }
 

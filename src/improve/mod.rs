@@ -141,7 +141,7 @@ pub trait Improver: Send + Sync {
     fn name(&self) -> &'static str;
     /// Errors for option values no run can use, naming the option (checked before the loop
     /// of Algorithm 1 starts).
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), crate::option_error::OptionError> {
         Ok(())
     }
     /// Improve the run's working mesh; `stages` are the run's strategy, parameterizer and

@@ -6,37 +6,37 @@
 //! through edges; exactly one boundary loop; Euler characteristic V − E + F = 1. A connected,
 //! oriented, manifold surface with one boundary loop and χ = 1 is a disk (χ = 2 − 2g − b).
 
-use super::InvariantError;
+use super::{DiskDefect, InvariantError, Offenders};
 use crate::ids::{EdgeKey, FaceId, VertexId};
 use crate::mesh::{TriMesh, UnionFind};
 use std::collections::HashMap;
 
-fn not_disk(reason: String) -> InvariantError {
-    InvariantError::NotADisk { reason }
+fn not_disk(defect: DiskDefect) -> InvariantError {
+    InvariantError::NotADisk(defect)
 }
 
 /// Certify that `faces` of `mesh` form a topological disk and return its boundary loop:
 /// an ordered vertex cycle following the patch faces' half-edge direction (the patch lies to
 /// its left), starting at its smallest vertex id.
 ///
-/// Errors are [`InvariantError::NotADisk`] whose reason names the offending face, edge
-/// (`edge (v3, v9)`), vertex (`vertex v4`) or count.
+/// Errors are [`InvariantError::NotADisk`] whose [`DiskDefect`] names the offending face,
+/// edge, vertex or count.
 pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, InvariantError> {
     if faces.is_empty() {
-        return Err(not_disk("no faces".into()));
+        return Err(not_disk(DiskDefect::NoFaces));
     }
     let mut sorted = faces.to_vec();
     sorted.sort_unstable();
     for w in sorted.windows(2) {
         if w[0] == w[1] {
-            return Err(not_disk(format!("face {} listed twice", w[0])));
+            return Err(not_disk(DiskDefect::RepeatedFace(w[0])));
         }
     }
     if let Some(f) = sorted.iter().find(|f| f.idx() >= mesh.n_faces()) {
-        return Err(not_disk(format!(
-            "face {f} does not exist (mesh has {} faces)",
-            mesh.n_faces()
-        )));
+        return Err(not_disk(DiskDefect::FaceOutOfRange {
+            face: *f,
+            faces: mesh.n_faces(),
+        }));
     }
     // Directed edges of the patch, grouped by undirected edge: (from, to, local face index).
     let mut edges: HashMap<EdgeKey, Vec<(VertexId, VertexId, usize)>> = HashMap::new();
@@ -52,16 +52,16 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
     for key in &keys {
         let hs = &edges[key];
         if hs.len() > 2 {
-            return Err(not_disk(format!(
-                "edge {key} has {} patch faces (non-manifold)",
-                hs.len()
-            )));
+            return Err(not_disk(DiskDefect::NonManifoldEdge {
+                edge: *key,
+                faces: hs.len(),
+            }));
         }
         if hs.len() == 2 && hs[0].0 == hs[1].0 {
-            return Err(not_disk(format!(
-                "edge {key}: its two patch faces {} and {} are oriented inconsistently",
-                sorted[hs[0].2], sorted[hs[1].2]
-            )));
+            return Err(not_disk(DiskDefect::InconsistentEdge {
+                edge: *key,
+                faces: Some((sorted[hs[0].2], sorted[hs[1].2])),
+            }));
         }
     }
     // Vertex-manifold: the patch faces around each vertex form one fan, i.e. are connected
@@ -99,9 +99,10 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
         }
         let fans = sets.count();
         if fans > 1 {
-            return Err(not_disk(format!(
-                "vertex {v} is a pinch: its patch faces form {fans} separate fans"
-            )));
+            return Err(not_disk(DiskDefect::Pinch {
+                vertex: v,
+                fans: Some(fans),
+            }));
         }
     }
     // Connected through edges.
@@ -113,11 +114,10 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
         }
     }
     if let Some(k) = (0..sorted.len()).find(|&k| sets.find(k) != 0) {
-        let n = sets.count();
-        return Err(not_disk(format!(
-            "not connected: {n} components (faces {} and {} are not joined through edges)",
-            sorted[0], sorted[k]
-        )));
+        return Err(not_disk(DiskDefect::Disconnected {
+            components: sets.count(),
+            faces: Some((sorted[0], sorted[k])),
+        }));
     }
     // Boundary loops: boundary half-edges, one outgoing per vertex (vertex-manifold).
     let mut next: HashMap<VertexId, VertexId> = HashMap::new();
@@ -128,10 +128,9 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
         }
     }
     if next.is_empty() {
-        return Err(not_disk(format!(
-            "no boundary: the {} faces form a closed surface",
-            sorted.len()
-        )));
+        return Err(not_disk(DiskDefect::Closed {
+            faces: sorted.len(),
+        }));
     }
     let mut starts: Vec<VertexId> = next.keys().copied().collect();
     starts.sort_unstable();
@@ -146,13 +145,13 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
         let mut v = s;
         loop {
             let Some(&w) = next.get(&v) else {
-                return Err(not_disk(format!("boundary is open at vertex {v}")));
+                return Err(not_disk(DiskDefect::OpenBoundary(v)));
             };
             if w == s {
                 break;
             }
             if seen.contains_key(&w) {
-                return Err(not_disk(format!("boundary revisits vertex {w}")));
+                return Err(not_disk(DiskDefect::BoundaryRevisits(w)));
             }
             seen.insert(w, loops.len());
             lp.push(w);
@@ -161,20 +160,17 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
         loops.push(lp);
     }
     if loops.len() != 1 {
-        let firsts: Vec<String> = loops.iter().map(|l| l[0].to_string()).collect();
-        return Err(not_disk(format!(
-            "{} boundary loops (through vertices {})",
-            loops.len(),
-            firsts.join(", ")
-        )));
+        return Err(not_disk(DiskDefect::BoundaryLoops {
+            loops: loops.len(),
+            starts: Offenders(loops.iter().map(|l| l[0]).collect()),
+        }));
     }
     let chi = verts.len() as i64 - keys.len() as i64 + sorted.len() as i64;
     if chi != 1 {
-        return Err(not_disk(format!(
-            "Euler characteristic V − E + F = {} − {} + {} = {chi}, not 1",
+        return Err(not_disk(DiskDefect::euler(
             verts.len(),
             keys.len(),
-            sorted.len()
+            sorted.len(),
         )));
     }
     Ok(loops.pop().unwrap_or_default())
@@ -186,9 +182,9 @@ mod tests {
     use crate::mesh::generators;
     use nalgebra::Point3;
 
-    fn reason(e: InvariantError) -> String {
+    fn defect(e: InvariantError) -> DiskDefect {
         match e {
-            InvariantError::NotADisk { reason } => reason,
+            InvariantError::NotADisk(d) => d,
             other => panic!("unexpected error {other}"),
         }
     }
@@ -216,11 +212,14 @@ mod tests {
     #[test]
     fn rejects_annulus_closed_surface_and_disjoint_triangles() {
         let cyl = generators::cylinder(1.0, 1.0, 8, 2);
-        let r = reason(certify_disk(&cyl, &all(&cyl)).unwrap_err());
-        assert!(r.starts_with("2 boundary loops"), "{r}");
+        let r = defect(certify_disk(&cyl, &all(&cyl)).unwrap_err());
+        assert!(
+            matches!(r, DiskDefect::BoundaryLoops { loops: 2, .. }),
+            "{r}"
+        );
         let s = generators::icosphere(1.0, 0);
-        let r = reason(certify_disk(&s, &all(&s)).unwrap_err());
-        assert!(r.starts_with("no boundary"), "{r}");
+        let r = defect(certify_disk(&s, &all(&s)).unwrap_err());
+        assert_eq!(r, DiskDefect::Closed { faces: 20 });
         let p = vec![
             Point3::new(0.0, 0.0, 0.0),
             Point3::new(1.0, 0.0, 0.0),
@@ -230,9 +229,14 @@ mod tests {
             Point3::new(5.0, 1.0, 0.0),
         ];
         let m = TriMesh::from_indices(p, &[[0, 1, 2], [3, 4, 5]]).unwrap();
-        let r = reason(certify_disk(&m, &all(&m)).unwrap_err());
-        assert!(r.starts_with("not connected: 2 components"), "{r}");
-        assert!(r.contains("f0 and f1"), "{r}");
+        let r = defect(certify_disk(&m, &all(&m)).unwrap_err());
+        assert_eq!(
+            r,
+            DiskDefect::Disconnected {
+                components: 2,
+                faces: Some((FaceId(0), FaceId(1)))
+            }
+        );
     }
 
     #[test]
@@ -246,10 +250,17 @@ mod tests {
         ];
         // Two triangles meeting only at v0.
         let m = TriMesh::from_indices(p, &[[1, 2, 0], [3, 4, 0]]).unwrap();
-        let r = reason(certify_disk(&m, &all(&m)).unwrap_err());
+        let r = defect(certify_disk(&m, &all(&m)).unwrap_err());
         assert_eq!(
             r,
-            "vertex v0 is a pinch: its patch faces form 2 separate fans"
+            DiskDefect::Pinch {
+                vertex: VertexId(0),
+                fans: Some(2)
+            }
+        );
+        assert_eq!(
+            r.to_string(),
+            "vertex v0 is a pinch: its faces form 2 separate fans"
         );
     }
 
@@ -263,21 +274,36 @@ mod tests {
             Point3::new(0.5, 0.0, 1.0),
         ];
         let m = TriMesh::from_indices(p.clone(), &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap();
-        let r = reason(certify_disk(&m, &all(&m)).unwrap_err());
-        assert!(r.starts_with("edge (v0, v1) has 3 patch faces"), "{r}");
+        let v01 = EdgeKey::new(VertexId(0), VertexId(1));
+        let r = defect(certify_disk(&m, &all(&m)).unwrap_err());
+        assert_eq!(
+            r,
+            DiskDefect::NonManifoldEdge {
+                edge: v01,
+                faces: 3
+            }
+        );
         let m = TriMesh::from_indices(p, &[[0, 1, 2], [0, 1, 3]]).unwrap();
-        let r = reason(certify_disk(&m, &all(&m)).unwrap_err());
-        assert!(r.starts_with("edge (v0, v1): its two patch faces"), "{r}");
-        let r = reason(certify_disk(&m, &[FaceId(0), FaceId(0)]).unwrap_err());
-        assert_eq!(r, "face f0 listed twice");
+        let r = defect(certify_disk(&m, &all(&m)).unwrap_err());
+        assert_eq!(
+            r,
+            DiskDefect::InconsistentEdge {
+                edge: v01,
+                faces: Some((FaceId(0), FaceId(1)))
+            }
+        );
+        let r = defect(certify_disk(&m, &[FaceId(0), FaceId(0)]).unwrap_err());
+        assert_eq!(r, DiskDefect::RepeatedFace(FaceId(0)));
     }
 
     #[test]
     fn rejects_torus_with_a_hole_by_euler_characteristic() {
         let t = generators::torus(2.0, 0.5, 8, 6);
         let faces: Vec<FaceId> = t.faces().skip(1).collect();
-        let r = reason(certify_disk(&t, &faces).unwrap_err());
-        assert!(r.starts_with("Euler characteristic"), "{r}");
-        assert!(r.ends_with("= -1, not 1"), "{r}");
+        let r = defect(certify_disk(&t, &faces).unwrap_err());
+        assert!(
+            matches!(r, DiskDefect::EulerCharacteristic { chi: -1, .. }),
+            "{r}"
+        );
     }
 }

@@ -108,12 +108,10 @@ pub enum InvariantError {
     /// Corners of the input's boundary curves that are not output vertices.
     #[error("boundary corners lost (input vertices): {0}")]
     BoundaryCornersLost(Offenders<VertexId>),
-    /// A patch that is not a topological disk.
-    #[error("patch is not a disk: {reason}")]
-    NotADisk {
-        /// what is wrong, naming the vertex, edge or count
-        reason: String,
-    },
+    /// A face set (a patch, a disk handed to a parameterizer, a planar output) that is not a
+    /// topological disk.
+    #[error("not a disk: {0}")]
+    NotADisk(DiskDefect),
     /// A 2D map with non-positive triangles or a self-touching boundary.
     #[error("map is not bijective: {reason}")]
     NotBijective {
@@ -133,6 +131,8 @@ pub enum InvariantError {
 
 mod disk;
 pub use disk::*;
+mod disk_defect;
+pub use disk_defect::DiskDefect;
 mod bijective;
 pub use bijective::*;
 

@@ -289,12 +289,11 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
     let n_edges = (he.len() + boundary_he.len()) / 2;
     let chi = np as i64 - n_edges as i64 + out.triangles.len() as i64;
     if chi != 1 {
-        return Err(InvariantError::NotADisk {
-            reason: format!(
-                "planar output has V − E + F = {np} − {n_edges} + {} = {chi}",
-                out.triangles.len()
-            ),
-        });
+        return Err(InvariantError::NotADisk(super::DiskDefect::euler(
+            np,
+            n_edges,
+            out.triangles.len(),
+        )));
     }
     // (7) area.
     let poly: Vec<Point2<f64>> = domain

@@ -12,6 +12,7 @@ mod obj;
 mod off;
 mod outputs;
 pub mod patches;
+pub mod paths;
 mod ply;
 mod polygon;
 pub mod sol;

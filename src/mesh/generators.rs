@@ -14,12 +14,45 @@ use thiserror::Error;
 /// Why a generator could not build its surface (only [`disk_with_holes`] can fail).
 #[derive(Debug, Error)]
 pub enum GeneratorError {
-    /// The parameters describe no surface (a hole outside the disk, overlapping holes, ...).
-    #[error("invalid parameters: {0}")]
-    InvalidParameters(String),
-    /// The constrained Delaunay triangulation refused the points.
-    #[error("triangulation failed: {0}")]
-    Triangulation(String),
+    /// Radius and lattice spacing out of range (need 0 < spacing < radius, radius / spacing
+    /// at most 1e4).
+    #[error(
+        "invalid parameters: radius {radius} and spacing {spacing} (need 0 < spacing < radius, \
+         radius / spacing at most 1e4)"
+    )]
+    Spacing {
+        /// the disk's radius
+        radius: f64,
+        /// the lattice spacing
+        spacing: f64,
+    },
+    /// Wall layers that are not positive and ascending.
+    #[error("invalid parameters: wall layers {0:?} (need positive and ascending)")]
+    WallLayers(Vec<f64>),
+    /// A hole (with its wall layers) not inside the disk by a spacing.
+    #[error(
+        "invalid parameters: hole {hole} (centre {centre:?}, radius {radius}) with its wall \
+         layers is not inside the disk by a spacing"
+    )]
+    HoleOutside {
+        /// the hole's index
+        hole: usize,
+        /// its centre
+        centre: [f64; 2],
+        /// its radius
+        radius: f64,
+    },
+    /// Two holes (with their wall layers) closer than a spacing.
+    #[error(
+        "invalid parameters: holes {0} and {1} with their wall layers are closer than a spacing"
+    )]
+    HolesTooClose(usize, usize),
+    /// The constrained Delaunay triangulation refused a point (NaN, too large or too small).
+    #[error("triangulation failed: {0:?}")]
+    Triangulation(spade::InsertionError),
+    /// The circles' polygon sides cross.
+    #[error("triangulation failed: crossing circle sides")]
+    CrossingSides,
 }
 
 fn build(positions: Vec<Point3<f64>>, tris: Vec<[usize; 3]>) -> TriMesh {
@@ -436,11 +469,9 @@ pub fn disk_with_holes(
         spade::ConstrainedDelaunayTriangulation::try_bulk_load_cdt(verts, edges, |_| {
             conflict = true
         })
-        .map_err(|e| GeneratorError::Triangulation(format!("{e:?}")))?;
+        .map_err(GeneratorError::Triangulation)?;
     if conflict {
-        return Err(GeneratorError::Triangulation(
-            "crossing circle sides".into(),
-        ));
+        return Err(GeneratorError::CrossingSides);
     }
     use spade::Triangulation as _;
     let positions: Vec<Point3<f64>> = cdt
@@ -472,38 +503,29 @@ fn check_holes(
     spacing: f64,
     wall_layers: &[f64],
 ) -> Result<(), GeneratorError> {
-    let bad = |s: String| Err(GeneratorError::InvalidParameters(s));
-    if !(r > 0.0 && r.is_finite() && spacing > 0.0 && spacing < r) {
-        return bad(format!(
-            "radius {r} and spacing {spacing} (need 0 < spacing < radius)"
-        ));
-    }
     // The lattice has (r/spacing)² points; refuse sizes beyond any use.
-    if r / spacing > 1e4 {
-        return bad(format!("radius / spacing = {} (at most 1e4)", r / spacing));
+    if !(r > 0.0 && r.is_finite() && spacing > 0.0 && spacing < r) || r / spacing > 1e4 {
+        return Err(GeneratorError::Spacing { radius: r, spacing });
     }
     if !wall_layers.windows(2).all(|w| w[0] < w[1])
         || wall_layers.first().is_some_and(|d| d.is_nan() || *d <= 0.0)
     {
-        return bad(format!(
-            "wall layers {wall_layers:?} (need positive and ascending)"
-        ));
+        return Err(GeneratorError::WallLayers(wall_layers.to_vec()));
     }
     let reach = wall_layers.last().copied().unwrap_or(0.0);
     for (i, h) in holes.iter().enumerate() {
         let d = h.centre[0].hypot(h.centre[1]);
         if !(h.radius > 0.0 && d + h.radius + reach + spacing <= r) {
-            return bad(format!(
-                "hole {i} (centre {:?}, radius {}) with its wall layers is not inside the disk by a spacing",
-                h.centre, h.radius
-            ));
+            return Err(GeneratorError::HoleOutside {
+                hole: i,
+                centre: h.centre,
+                radius: h.radius,
+            });
         }
         for (k, g) in holes.iter().enumerate().skip(i + 1) {
             let d = (h.centre[0] - g.centre[0]).hypot(h.centre[1] - g.centre[1]);
             if d < h.radius + g.radius + 2.0 * reach + spacing {
-                return bad(format!(
-                    "holes {i} and {k} with their wall layers are closer than a spacing"
-                ));
+                return Err(GeneratorError::HolesTooClose(i, k));
             }
         }
     }
@@ -772,19 +794,22 @@ mod tests {
             centre: [x, 0.0],
             radius: r,
         };
-        for (holes, what) in [
-            (vec![h(0.9, 0.2)], "not inside the disk"),
-            (vec![h(0.3, 0.2), h(-0.05, 0.2)], "closer than a spacing"),
-            (vec![h(0.0, -0.1)], "not inside the disk"),
-        ] {
-            let e = disk_with_holes(1.0, &holes, 0.05, &[])
-                .unwrap_err()
-                .to_string();
-            assert!(e.contains(what), "{e}");
-        }
-        assert!(disk_with_holes(1.0, &[], 2.0, &[]).is_err());
+        let e = disk_with_holes(1.0, &[h(0.9, 0.2)], 0.05, &[]).unwrap_err();
+        assert!(
+            matches!(e, GeneratorError::HoleOutside { hole: 0, .. }),
+            "{e}"
+        );
+        let e = disk_with_holes(1.0, &[h(0.3, 0.2), h(-0.05, 0.2)], 0.05, &[]).unwrap_err();
+        assert!(matches!(e, GeneratorError::HolesTooClose(0, 1)), "{e}");
+        let e = disk_with_holes(1.0, &[h(0.0, -0.1)], 0.05, &[]).unwrap_err();
+        assert!(
+            matches!(e, GeneratorError::HoleOutside { hole: 0, .. }),
+            "{e}"
+        );
+        let e = disk_with_holes(1.0, &[], 2.0, &[]).unwrap_err();
+        assert!(matches!(e, GeneratorError::Spacing { .. }), "{e}");
         let e = disk_with_holes(1.0, &[h(0.0, 0.2)], 0.05, &[0.02, 0.01]).unwrap_err();
-        assert!(e.to_string().contains("ascending"), "{e}");
+        assert!(matches!(e, GeneratorError::WallLayers(_)), "{e}");
     }
 
     #[test]

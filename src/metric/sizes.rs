@@ -11,6 +11,7 @@
 //! directions and only its sizes shrink; passes over the edges repeat until nothing changes.
 
 use crate::mesh::TriMesh;
+use crate::option_error::OptionError;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use serde::Serialize;
 
@@ -33,21 +34,35 @@ impl SizeOptions {
     }
 
     /// Errors for values no run can use, naming the option.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), OptionError> {
         let pos = |x: f64| x.is_finite() && x > 0.0;
+        let size = |option, value| OptionError::OutOfRange {
+            option,
+            value,
+            range: "a positive size",
+        };
         if let Some(h) = self.hmin.filter(|h| !pos(*h)) {
-            return Err(format!("hmin must be a positive size, got {h}"));
+            return Err(size("hmin", h));
         }
         if let Some(h) = self.hmax.filter(|h| !pos(*h)) {
-            return Err(format!("hmax must be a positive size, got {h}"));
+            return Err(size("hmax", h));
         }
         if let (Some(a), Some(b)) = (self.hmin, self.hmax) {
             if a > b {
-                return Err(format!("hmin {a} is larger than hmax {b}"));
+                return Err(OptionError::Crossed {
+                    low: "hmin",
+                    low_value: a,
+                    high: "hmax",
+                    high_value: b,
+                });
             }
         }
         if let Some(g) = self.hgrad.filter(|g| !(g.is_finite() && *g > 1.0)) {
-            return Err(format!("hgrad must be a number above 1, got {g}"));
+            return Err(OptionError::OutOfRange {
+                option: "hgrad",
+                value: g,
+                range: "a number above 1",
+            });
         }
         Ok(())
     }
@@ -199,24 +214,32 @@ mod tests {
         let out = apply_sizes(&m, &metrics, 1.0, 0.5, &o);
         assert!((size_along(&out[0], Vector3::x(), 1.0) - 0.05).abs() < 1e-12);
         assert!(o.validate().is_ok());
-        assert!(SizeOptions {
-            hmin: Some(3.0),
-            ..o
-        }
-        .validate()
-        .is_err());
-        assert!(SizeOptions {
-            hgrad: Some(1.0),
-            ..o
-        }
-        .validate()
-        .is_err());
-        assert!(SizeOptions {
-            hmax: Some(f64::NAN),
-            ..o
-        }
-        .validate()
-        .is_err());
+        let refused = |o: SizeOptions| o.validate().expect_err("refused");
+        assert!(matches!(
+            refused(SizeOptions {
+                hmin: Some(3.0),
+                ..o
+            }),
+            OptionError::Crossed { low: "hmin", low_value, high_value, .. }
+                if low_value == 3.0 && high_value == 2.0
+        ));
+        assert!(matches!(
+            refused(SizeOptions {
+                hgrad: Some(1.0),
+                ..o
+            }),
+            OptionError::OutOfRange {
+                option: "hgrad",
+                ..
+            }
+        ));
+        assert!(matches!(
+            refused(SizeOptions {
+                hmax: Some(f64::NAN),
+                ..o
+            }),
+            OptionError::OutOfRange { option: "hmax", .. }
+        ));
     }
 
     #[test]

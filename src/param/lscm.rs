@@ -7,8 +7,9 @@
 
 use super::distortion::triangle_frames;
 use super::sparse::{Llt, VertexSystem};
-use super::ParamError;
+use super::{LinearSystem, ParamError};
 use crate::ids::VertexId;
+use crate::invariants::{DiskDefect, InvariantError};
 use crate::mesh::TriMesh;
 use faer::Mat;
 use nalgebra::Point2;
@@ -18,10 +19,7 @@ use nalgebra::Point2;
 /// diameter heuristic).
 fn pins(disk: &TriMesh, boundary: &[VertexId]) -> Result<(VertexId, VertexId, f64), ParamError> {
     if boundary.len() < 3 {
-        return Err(ParamError::NotADisk(format!(
-            "boundary of {} vertices",
-            boundary.len()
-        )));
+        return Err(InvariantError::NotADisk(DiskDefect::ShortBoundary(boundary.len())).into());
     }
     let far = |from: VertexId| -> VertexId {
         let p = disk.position(from);
@@ -37,7 +35,7 @@ fn pins(disk: &TriMesh, boundary: &[VertexId]) -> Result<(VertexId, VertexId, f6
     let p0 = far(boundary[0]);
     let p1 = far(p0);
     if p0 == p1 {
-        return Err(ParamError::Solver("LSCM: coincident pins".to_string()));
+        return Err(ParamError::CoincidentPins { vertex: p0 });
     }
     Ok((p0, p1, (disk.position(p1) - disk.position(p0)).norm()))
 }
@@ -63,7 +61,10 @@ fn conformal_rows(g: &[[f64; 2]; 3]) -> ([f64; 6], [f64; 6]) {
 /// Solved by faer's sparse Cholesky. No certification, no area scaling.
 pub fn lscm(disk: &TriMesh, boundary: &[VertexId]) -> Result<Vec<Point2<f64>>, ParamError> {
     let pinned = pins(disk, boundary)?;
-    let system = VertexSystem::new(disk).map_err(ParamError::Solver)?;
+    let system = VertexSystem::new(disk).map_err(|failure| ParamError::Solver {
+        system: LinearSystem::VertexPattern,
+        failure,
+    })?;
     solve_pinned(disk, pinned, &system)
 }
 
@@ -123,7 +124,10 @@ fn solve_pinned(
     }
     Llt::new(system)
         .solve(&vals, &mut sol)
-        .map_err(|e| ParamError::Solver(format!("LSCM Cholesky: {e}")))?;
+        .map_err(|failure| ParamError::Solver {
+            system: LinearSystem::Lscm,
+            failure,
+        })?;
     let uv: Vec<Point2<f64>> = (0..n)
         .map(|v| Point2::new(sol[(2 * v, 0)], sol[(2 * v + 1, 0)]))
         .collect();
@@ -136,9 +140,10 @@ fn finite(uv: Vec<Point2<f64>>) -> Result<Vec<Point2<f64>>, ParamError> {
         .iter()
         .position(|p| !(p.x.is_finite() && p.y.is_finite()))
     {
-        Some(v) => Err(ParamError::Solver(format!(
-            "LSCM gave a non-finite position for v{v}"
-        ))),
+        Some(v) => Err(ParamError::NonFinite {
+            system: LinearSystem::Lscm,
+            vertex: VertexId::new(v),
+        }),
         None => Ok(uv),
     }
 }

@@ -17,7 +17,8 @@ pub use sd::{
 };
 pub use tutte::{circle_boundary, scale_to_area, tutte_embedding, Tutte, TutteWeights};
 
-use crate::ids::VertexId;
+use crate::ids::{FaceId, VertexId};
+use crate::invariants::{DiskDefect, InvariantError, Offenders};
 use crate::mesh::{Topology, TriMesh};
 use nalgebra::Point2;
 use serde::Serialize;
@@ -26,15 +27,110 @@ use thiserror::Error;
 /// Errors of parameterization.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ParamError {
-    /// The input is not a topological disk.
-    #[error("not a disk: {0}")]
-    NotADisk(String),
+    /// The mesh arrays are not a mesh.
+    #[error("the disk mesh: {0}")]
+    Mesh(#[from] crate::mesh::MeshError),
+    /// The input is not a topological disk ([`InvariantError::NotADisk`]).
+    #[error(transparent)]
+    Input(#[from] InvariantError),
     /// Even the initial (Tutte) map could not be certified.
     #[error("no certified map: {0}")]
-    NotCertified(String),
+    NotCertified(#[source] InvariantError),
+    /// The map under optimisation flipped a triangle.
+    #[error("no certified map: {face} is flipped during optimisation")]
+    Flipped {
+        /// the flipped triangle
+        face: FaceId,
+    },
+    /// The optimisation's start has a flipped or degenerate triangle (locally injective mode).
+    #[error(
+        "no certified map: the start has a flipped or degenerate triangle{}",
+        face.map_or(String::new(), |f| format!(" ({f})"))
+    )]
+    FlippedStart {
+        /// the first triangle of non-positive area, if one is (else the energy is not finite
+        /// for another reason)
+        face: Option<FaceId>,
+    },
+    /// A boundary vertex reached a boundary edge during optimisation.
+    #[error("no certified map: boundary vertex {vertex} touches boundary edge {edge}")]
+    BoundaryTouch {
+        /// the vertex
+        vertex: VertexId,
+        /// the edge it touches
+        edge: crate::ids::EdgeKey,
+    },
     /// The linear solver failed.
-    #[error("linear solve failed: {0}")]
-    Solver(String),
+    #[error("linear solve failed: {system}: {failure}")]
+    Solver {
+        /// which system
+        system: LinearSystem,
+        /// which step of it
+        failure: SolveFailure,
+    },
+    /// A solve gave a NaN or infinite position.
+    #[error("{system} gave a non-finite position for {vertex}")]
+    NonFinite {
+        /// which system
+        system: LinearSystem,
+        /// the vertex
+        vertex: VertexId,
+    },
+    /// Boundary vertices and their positions differ in number.
+    #[error("{vertices} boundary vertices but {positions} boundary positions")]
+    BoundaryCount {
+        /// boundary vertices
+        vertices: usize,
+        /// positions given
+        positions: usize,
+    },
+    /// LSCM's two pinned vertices are the same (a boundary of coincident points).
+    #[error("LSCM: coincident pins at {vertex}")]
+    CoincidentPins {
+        /// the pinned vertex
+        vertex: VertexId,
+    },
+}
+
+/// The linear systems of parameterization.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
+pub enum LinearSystem {
+    /// The Tutte Laplacian.
+    Tutte,
+    /// The LSCM normal equations.
+    Lscm,
+    /// The Newton Hessian of the symmetric Dirichlet optimisation.
+    NewtonHessian,
+    /// The 1-ring pattern shared by LSCM and Newton (its symbolic factorisation).
+    VertexPattern,
+}
+
+impl std::fmt::Display for LinearSystem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LinearSystem::Tutte => "Tutte Laplacian",
+            LinearSystem::Lscm => "LSCM",
+            LinearSystem::NewtonHessian => "Newton Hessian",
+            LinearSystem::VertexPattern => "vertex 1-ring pattern",
+        })
+    }
+}
+
+/// Which step of a sparse solve failed (faer's error kinds).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Error, Serialize)]
+pub enum SolveFailure {
+    /// The matrix could not be assembled from its triplets.
+    #[error("assembling the matrix")]
+    Assembly,
+    /// The symbolic factorisation failed (out of memory or index overflow).
+    #[error("symbolic factorisation")]
+    Symbolic,
+    /// The Cholesky factorisation met a non-positive pivot.
+    #[error("not positive definite (Cholesky)")]
+    NotPositiveDefinite,
+    /// The LU factorisation failed (a singular matrix).
+    #[error("LU factorisation (singular matrix)")]
+    Lu,
 }
 
 /// Distortion of a 2D map of a 3D disk.
@@ -84,33 +180,46 @@ pub trait Parameterizer: Send + Sync {
 /// the starting vertex): an oriented manifold, one component, V − E + F = 1, every vertex
 /// referenced. Errors name the offending count or vertex.
 pub fn validate_disk(disk: &TriMesh, boundary: &[VertexId]) -> Result<(), ParamError> {
-    let bad = |s: String| Err(ParamError::NotADisk(s));
-    if let Err(e) = disk.validate() {
-        return bad(e.to_string());
-    }
+    let bad = |d: DiskDefect| Err(ParamError::Input(InvariantError::NotADisk(d)));
+    disk.validate()?;
     if let Some(v) = disk.unreferenced_vertices().first() {
-        return bad(format!("{v} is referenced by no triangle"));
+        return bad(DiskDefect::UnreferencedVertex(*v));
     }
     let topo = Topology::build(disk);
     if let Some((e, k)) = topo.non_manifold_edges().first() {
-        return bad(format!("edge {e} has {k} faces"));
+        return bad(DiskDefect::NonManifoldEdge {
+            edge: *e,
+            faces: *k,
+        });
     }
     if let Some(e) = topo.inconsistent_edges().first() {
-        return bad(format!("faces on edge {e} are inconsistently oriented"));
+        return bad(DiskDefect::InconsistentEdge {
+            edge: *e,
+            faces: None,
+        });
     }
     if let Some(v) = topo.non_manifold_vertices().first() {
-        return bad(format!("vertex {v} is non-manifold"));
+        return bad(DiskDefect::Pinch {
+            vertex: *v,
+            fans: None,
+        });
     }
     if topo.components().len() != 1 {
-        return bad(format!("{} components (need 1)", topo.components().len()));
+        return bad(DiskDefect::Disconnected {
+            components: topo.components().len(),
+            faces: None,
+        });
     }
-    let chi = topo.euler_characteristic();
-    if chi != 1 {
-        return bad(format!("Euler characteristic V − E + F = {chi} (need 1)"));
+    if topo.euler_characteristic() != 1 {
+        return bad(DiskDefect::euler(
+            disk.n_vertices(),
+            topo.edges().len(),
+            disk.n_faces(),
+        ));
     }
     let loops = topo.boundary_loops();
     if loops.len() != 1 {
-        return bad(format!("{} boundary loops (need 1)", loops.len()));
+        return bad(boundary_loops(loops));
     }
     let l = &loops[0];
     let start = boundary
@@ -119,17 +228,21 @@ pub fn validate_disk(disk: &TriMesh, boundary: &[VertexId]) -> Result<(), ParamE
     let matches = l.len() == boundary.len()
         && start.is_some_and(|s| (0..l.len()).all(|i| l[(s + i) % l.len()] == boundary[i]));
     if !matches {
-        return bad(format!(
-            "the given boundary ({} vertices, starting at {}) is not the mesh's boundary loop \
-             ({} vertices, surface on the left)",
-            boundary.len(),
-            boundary
-                .first()
-                .map_or("nothing".to_string(), |v| v.to_string()),
-            l.len()
-        ));
+        return bad(DiskDefect::BoundaryMismatch {
+            given: boundary.len(),
+            start: boundary.first().copied(),
+            actual: l.len(),
+        });
     }
     Ok(())
+}
+
+/// The defect of a mesh with `loops` boundary loops (not 1), naming each loop's first vertex.
+fn boundary_loops(loops: &[Vec<VertexId>]) -> DiskDefect {
+    DiskDefect::BoundaryLoops {
+        loops: loops.len(),
+        starts: Offenders(loops.iter().filter_map(|l| l.first().copied()).collect()),
+    }
 }
 
 /// The boundary loop of a disk mesh (surface on the left), after [`validate_disk`]-style
@@ -138,12 +251,7 @@ pub fn disk_boundary(disk: &TriMesh) -> Result<Vec<VertexId>, ParamError> {
     let topo = Topology::build(disk);
     let b = match topo.boundary_loops() {
         [l] => l.clone(),
-        ls => {
-            return Err(ParamError::NotADisk(format!(
-                "{} boundary loops (need 1)",
-                ls.len()
-            )))
-        }
+        ls => return Err(InvariantError::NotADisk(boundary_loops(ls)).into()),
     };
     validate_disk(disk, &b)?;
     Ok(b)
@@ -157,7 +265,7 @@ pub(crate) fn recertify(
     boundary: &[VertexId],
 ) -> Result<(), ParamError> {
     crate::invariants::certify_map_of_known_disk(uv, &disk.triangles, boundary)
-        .map_err(|e| ParamError::NotCertified(e.to_string()))
+        .map_err(ParamError::NotCertified)
 }
 
 /// Certify a map and turn a failure into [`ParamError::NotCertified`].
@@ -167,5 +275,5 @@ pub(crate) fn certify(
     boundary: &[VertexId],
 ) -> Result<(), ParamError> {
     crate::invariants::certify_bijective(uv, &disk.triangles, boundary)
-        .map_err(|e| ParamError::NotCertified(e.to_string()))
+        .map_err(ParamError::NotCertified)
 }

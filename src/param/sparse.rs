@@ -9,6 +9,7 @@
 //!   overlap repair and every Newton iteration ([`Llt`]).
 //! * [`solve_triplets`]: a system assembled from triplets, solved once (the Tutte map).
 
+use super::SolveFailure;
 use crate::ids::VertexId;
 use crate::mesh::TriMesh;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -167,7 +168,7 @@ pub(super) struct VertexSystem {
 
 impl VertexSystem {
     /// The pattern of `disk`'s vertex 1-rings and its symbolic factorisation.
-    pub(super) fn new(disk: &TriMesh) -> Result<VertexSystem, String> {
+    pub(super) fn new(disk: &TriMesh) -> Result<VertexSystem, SolveFailure> {
         let pattern = Pattern::new(disk.n_vertices(), &disk.triangles);
         let mut params = CholeskySymbolicParams::default();
         if pattern.dim() >= SUPERNODAL_MIN_DIM {
@@ -179,7 +180,7 @@ impl VertexSystem {
             Default::default(),
             params,
         )
-        .map_err(|e| format!("symbolic Cholesky: {e:?}"))?;
+        .map_err(|_| SolveFailure::Symbolic)?;
         Ok(VertexSystem { pattern, symbolic })
     }
 
@@ -188,7 +189,7 @@ impl VertexSystem {
     pub(super) fn get<'a>(
         cell: &'a OnceCell<VertexSystem>,
         disk: &TriMesh,
-    ) -> Result<&'a VertexSystem, String> {
+    ) -> Result<&'a VertexSystem, SolveFailure> {
         if let Some(s) = cell.get() {
             return Ok(s);
         }
@@ -223,7 +224,7 @@ impl<'a> Llt<'a> {
     /// Factorise the matrix with values `vals` (in pattern order) and overwrite `rhs` with
     /// its solution. Errors (leaving `rhs` unchanged) when the matrix is not numerically
     /// positive definite.
-    pub(super) fn solve(&mut self, vals: &[f64], rhs: &mut Mat<f64>) -> Result<(), String> {
+    pub(super) fn solve(&mut self, vals: &[f64], rhs: &mut Mat<f64>) -> Result<(), SolveFailure> {
         let a = self.system.pattern.matrix(vals);
         let llt = self
             .system
@@ -237,7 +238,7 @@ impl<'a> Llt<'a> {
                 MemStack::new(&mut self.mem),
                 Default::default(),
             )
-            .map_err(|e| format!("{e:?}"))?;
+            .map_err(|_| SolveFailure::NotPositiveDefinite)?;
         llt.solve_in_place_with_conj(
             Conj::No,
             rhs.as_mut(),
@@ -264,17 +265,17 @@ pub(super) fn solve_triplets(
     triplets: &[Triplet<usize, usize, f64>],
     rhs: &Mat<f64>,
     how: Factorization,
-) -> Result<Mat<f64>, String> {
+) -> Result<Mat<f64>, SolveFailure> {
     let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, triplets)
-        .map_err(|e| format!("assembling: {e:?}"))?;
+        .map_err(|_| SolveFailure::Assembly)?;
     // faer's high-level solvers use its global parallelism, which is sequential because faer
     // is built without its `rayon` feature (Cargo.toml); enabling that feature would need
     // explicit `Par::Seq` factorisations here, as in `Llt`.
     Ok(match how {
-        Factorization::Lu => a.sp_lu().map_err(|e| format!("LU: {e:?}"))?.solve(rhs),
+        Factorization::Lu => a.sp_lu().map_err(|_| SolveFailure::Lu)?.solve(rhs),
         Factorization::Cholesky => a
             .sp_cholesky(Side::Lower)
-            .map_err(|e| format!("Cholesky: {e:?}"))?
+            .map_err(|_| SolveFailure::NotPositiveDefinite)?
             .solve(rhs),
     })
 }

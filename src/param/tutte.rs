@@ -4,8 +4,11 @@
 //! Floater 2003); in floating point it is certified by `certify_bijective` anyway.
 
 use super::sparse::{solve_triplets, Factorization};
-use super::{certify, distortion, validate_disk, ParamError, Parameterization, Parameterizer};
+use super::{
+    certify, distortion, validate_disk, LinearSystem, ParamError, Parameterization, Parameterizer,
+};
 use crate::ids::VertexId;
+use crate::invariants::{DiskDefect, InvariantError};
 use crate::mesh::TriMesh;
 use faer::sparse::Triplet;
 use faer::Mat;
@@ -156,20 +159,21 @@ pub fn tutte_embedding(
 ) -> Result<Vec<Point2<f64>>, ParamError> {
     let n = disk.n_vertices();
     if boundary.len() != boundary_uv.len() {
-        return Err(ParamError::Solver(format!(
-            "{} boundary vertices but {} boundary positions",
-            boundary.len(),
-            boundary_uv.len()
-        )));
+        return Err(ParamError::BoundaryCount {
+            vertices: boundary.len(),
+            positions: boundary_uv.len(),
+        });
     }
     const FIXED: usize = usize::MAX;
     let mut uv = vec![Point2::origin(); n];
     let mut index = vec![0usize; n];
     for (v, p) in boundary.iter().zip(boundary_uv) {
         if v.idx() >= n {
-            return Err(ParamError::NotADisk(format!(
-                "boundary vertex {v} out of range"
-            )));
+            return Err(InvariantError::NotADisk(DiskDefect::VertexOutOfRange {
+                vertex: *v,
+                vertices: n,
+            })
+            .into());
         }
         index[v.idx()] = FIXED;
         uv[v.idx()] = *p;
@@ -205,8 +209,10 @@ pub fn tutte_embedding(
     } else {
         Factorization::Cholesky
     };
-    let sol = solve_triplets(n_free, &trips, &rhs, how)
-        .map_err(|e| ParamError::Solver(format!("Tutte Laplacian: {e}")))?;
+    let sol = solve_triplets(n_free, &trips, &rhs, how).map_err(|failure| ParamError::Solver {
+        system: LinearSystem::Tutte,
+        failure,
+    })?;
     for v in 0..n {
         let i = index[v];
         if i != FIXED {
@@ -217,9 +223,10 @@ pub fn tutte_embedding(
         .iter()
         .position(|p| !(p.x.is_finite() && p.y.is_finite()))
     {
-        return Err(ParamError::Solver(format!(
-            "Tutte solve gave a non-finite position for v{v}"
-        )));
+        return Err(ParamError::NonFinite {
+            system: LinearSystem::Tutte,
+            vertex: VertexId::new(v),
+        });
     }
     Ok(uv)
 }
@@ -231,20 +238,17 @@ pub(crate) fn certified_tutte(
     weights: TutteWeights,
 ) -> Result<(Vec<Point2<f64>>, TutteWeights), ParamError> {
     let circle = circle_boundary(disk, boundary, 1.0);
-    let mut last = String::new();
-    let mut tries = vec![weights];
-    if weights != TutteWeights::Uniform {
-        tries.push(TutteWeights::Uniform);
+    let mut uv = tutte_embedding(disk, boundary, &circle, weights)?;
+    scale_to_area(disk, &mut uv);
+    match certify(disk, &uv, boundary) {
+        Ok(()) => return Ok((uv, weights)),
+        Err(e) if weights == TutteWeights::Uniform => return Err(e),
+        Err(_) => {}
     }
-    for w in tries {
-        let mut uv = tutte_embedding(disk, boundary, &circle, w)?;
-        scale_to_area(disk, &mut uv);
-        match certify(disk, &uv, boundary) {
-            Ok(()) => return Ok((uv, w)),
-            Err(e) => last = format!("Tutte with {w:?} weights: {e}"),
-        }
-    }
-    Err(ParamError::NotCertified(last))
+    let mut uv = tutte_embedding(disk, boundary, &circle, TutteWeights::Uniform)?;
+    scale_to_area(disk, &mut uv);
+    certify(disk, &uv, boundary)?;
+    Ok((uv, TutteWeights::Uniform))
 }
 
 impl Parameterizer for Tutte {

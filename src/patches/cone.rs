@@ -169,9 +169,7 @@ impl PatchStrategy for ConePatches {
         let cone = fit_cone(ctx.mesh, &omega);
         let candidates = unprocessed_ring(ctx, seed_vertex);
         let Some(seed_face) = least_error_face(ctx.mesh, &cone, &candidates) else {
-            return Err(PatchError::InvalidMesh(format!(
-                "seed vertex {seed_vertex} has no unprocessed face"
-            )));
+            return Err(PatchError::SeedWithoutFace { seed: seed_vertex });
         };
         let mut grown = grow_patch(ctx, seed_face, &cone, &self.options);
         let mut cone = cone;

@@ -70,8 +70,7 @@ pub fn cover(
     opts: &CoverOptions,
     rng: &mut ChaCha8Rng,
 ) -> Result<CoverRun, PatchError> {
-    mesh.validate()
-        .map_err(|e| PatchError::InvalidMesh(e.to_string()))?;
+    mesh.validate()?;
     let topology = Topology::build(mesh);
     let nf = mesh.n_faces();
     let mut processed = vec![false; nf];

@@ -33,7 +33,7 @@ impl PatchMesh {
 /// Copy `faces` of `mesh` into a [`PatchMesh`], after certifying that they form a disk
 /// (`invariants::certify_disk`).
 pub fn extract_patch(mesh: &TriMesh, faces: &[FaceId]) -> Result<PatchMesh, PatchError> {
-    let boundary = crate::invariants::certify_disk(mesh, faces).map_err(PatchError::NotADisk)?;
+    let boundary = crate::invariants::certify_disk(mesh, faces)?;
     let mut face_to_global = faces.to_vec();
     face_to_global.sort_unstable();
     let mut local: HashMap<VertexId, VertexId> = HashMap::new();
@@ -99,7 +99,9 @@ mod tests {
         let all: Vec<FaceId> = m.faces().collect();
         assert!(matches!(
             extract_patch(&m, &all),
-            Err(PatchError::NotADisk(_))
+            Err(PatchError::Invariant(
+                crate::invariants::InvariantError::NotADisk(_)
+            ))
         ));
     }
 }

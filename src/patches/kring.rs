@@ -58,9 +58,7 @@ impl PatchStrategy for KRingDisks {
             return Ok(None);
         };
         let Some(&seed_face) = unprocessed_ring(ctx, seed_vertex).first() else {
-            return Err(PatchError::InvalidMesh(format!(
-                "seed vertex {seed_vertex} has no unprocessed face"
-            )));
+            return Err(PatchError::SeedWithoutFace { seed: seed_vertex });
         };
         let unprocessed =
             |g: crate::ids::FaceId| !ctx.processed.get(g.idx()).copied().unwrap_or(true);

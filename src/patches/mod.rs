@@ -44,9 +44,16 @@ use thiserror::Error;
 /// Errors of patch generation.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum PatchError {
-    /// The mesh handed to the strategy is not usable (non-manifold, …).
+    /// The mesh handed to the cover is not a valid mesh.
     #[error("patch generation: {0}")]
-    InvalidMesh(String),
+    Mesh(#[from] crate::mesh::MeshError),
+    /// The seed vertex a strategy picked has no unprocessed face (its context is not one the
+    /// strategy can grow from).
+    #[error("patch generation: seed vertex {seed} has no unprocessed face")]
+    SeedWithoutFace {
+        /// the seed vertex
+        seed: VertexId,
+    },
     /// A produced patch failed its certificate.
     #[error("patch{} (seed {seed}): {source}", patch.map(|p| format!(" {p}")).unwrap_or_default())]
     NotCertified {
@@ -57,9 +64,10 @@ pub enum PatchError {
         /// the violated invariant
         source: crate::invariants::InvariantError,
     },
-    /// A face set handed to [`extract_patch`] is not a disk.
-    #[error("not a disk: {0}")]
-    NotADisk(#[source] crate::invariants::InvariantError),
+    /// A face set handed to [`extract_patch`] failed its certificate (not a disk:
+    /// [`crate::invariants::InvariantError::NotADisk`]).
+    #[error(transparent)]
+    Invariant(#[from] crate::invariants::InvariantError),
     /// A strategy returned a patch without unprocessed faces (the loop would not progress).
     #[error("patch {patch} (seed {seed}) contains no unprocessed face")]
     NoProgress {

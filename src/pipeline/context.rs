@@ -298,8 +298,7 @@ impl LoopState {
                 max_deviation: ctx.plan.options.fidelity.max_deviation,
             },
             &ctx.flip_test,
-        )
-        .map_err(|e| PipelineError::Input(e.to_string()))?;
+        )?;
         let pinned = (0..work.mesh.n_vertices())
             .map(|v| {
                 ctx.corners.get(v).copied().unwrap_or(false) || features.is_pinned(VertexId::new(v))

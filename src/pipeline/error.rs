@@ -4,8 +4,10 @@
 use crate::ids::{EdgeKey, PatchId, VertexId};
 use crate::invariants::InvariantError;
 use crate::lift::LiftError;
+use crate::option_error::OptionError;
 use crate::param::ParamError;
 use crate::patches::PatchError;
+use crate::quality::TargetLength;
 use crate::remesh2d::Remesh2dError;
 use crate::stitch::StitchError;
 use serde::Serialize;
@@ -131,14 +133,14 @@ pub enum PipelineError {
     /// The working mesh failed its certificate after the feature lines were resampled, before
     /// the loop.
     #[error("after resampling the feature lines: {0}")]
-    FeatureLines(InvariantError),
+    FeatureLines(#[source] InvariantError),
     /// The final mesh self-intersects.
     #[error("final mesh: {0}")]
-    Final(InvariantError),
+    Final(#[source] InvariantError),
     /// The output mapped back to file units failed its exact re-certification (rounding of
     /// the new vertices).
     #[error("the output in file units (after mapping back from unit space): {0}")]
-    FileUnits(InvariantError),
+    FileUnits(#[source] InvariantError),
     /// The strategy returned a patch without an unprocessed face (the loop would not end).
     #[error(
         "patch {patch} (seed {seed}) contains no unprocessed face; the strategy must make progress"
@@ -196,9 +198,6 @@ pub enum PipelineError {
     /// The metric (a user metric that is not SPD on the surface, or the curvature estimate).
     #[error(transparent)]
     Metric(#[from] crate::metric::MetricError),
-    /// Invalid input or options.
-    #[error("{0}")]
-    Input(String),
     /// An input vertex is a corner of more faces than [`super::MAX_FACES_AT_VERTEX`]: the
     /// patch around it would hold them all (they are slivers meeting there, e.g. a polygon of
     /// that many corners cut into a fan), and a patch's parameterization, certificates and
@@ -216,6 +215,74 @@ pub enum PipelineError {
         faces: usize,
         /// the bound
         max: usize,
+    },
+    /// The input mesh has no faces.
+    #[error("the input mesh has no faces")]
+    EmptyInput,
+    /// The input mesh is not an oriented 2-manifold (the certificate names the elements).
+    #[error(
+        "the input mesh is not an oriented manifold: {0} (`conemesh remesh --repair`, or \
+         `repair=True` in Python, orients it and cuts non-manifold edges and vertices)"
+    )]
+    NotManifold(#[source] InvariantError),
+    /// A user metric whose tensor count is not the input's vertex count.
+    #[error("the metric has {tensors} tensors for {vertices} vertices")]
+    MetricCount {
+        /// tensors given
+        tensors: usize,
+        /// the input's vertices
+        vertices: usize,
+    },
+    /// An option value no run can use.
+    #[error(transparent)]
+    Option(#[from] OptionError),
+    /// An improver's option value no run can use.
+    #[error("improver `{improver}`: {source}")]
+    ImproverOption {
+        /// the improver
+        improver: &'static str,
+        /// the option
+        source: OptionError,
+    },
+    /// The target edge length L_tar is not a positive finite number.
+    #[error("target edge length {l_tar} is not a positive finite number: {}", target_note(.target, .l_avg))]
+    BadTarget {
+        /// L_tar
+        l_tar: f64,
+        /// how it was asked for
+        target: TargetLength,
+        /// the input's mean metric edge length L_avg
+        l_avg: f64,
+    },
+    /// A target edge length that would make far too many faces.
+    #[error(
+        "target edge length {l_tar:e} is too small for this input: the output would have \
+         about {expected:.3e} faces (more than {max:e})"
+    )]
+    TargetTooSmall {
+        /// L_tar
+        l_tar: f64,
+        /// the faces the output would have
+        expected: f64,
+        /// the most allowed
+        max: f64,
+    },
+    /// The metric after the size controls (`hmin`, `hmax`, `hgrad`) is not usable.
+    #[error("size-controlled metric: {0}")]
+    SizedMetric(#[source] crate::metric::MetricError),
+    /// The metric scaled by the fidelity control's a-priori factors is not usable.
+    #[error("fidelity-scaled metric: {0}")]
+    FidelityMetric(#[source] crate::metric::MetricError),
+    /// The feature lines could not be resampled before the loop.
+    #[error(transparent)]
+    Features(#[from] crate::features::FeatureError),
+    /// An improver gave a target flag count that is not the working mesh's face count.
+    #[error("an improver gave {flags} target flags for {faces} faces")]
+    ImproverTargets {
+        /// flags given
+        flags: usize,
+        /// the working mesh's faces
+        faces: usize,
     },
     /// The run was stopped through [`super::Cancel`] (e.g. Ctrl-C in the Python package);
     /// nothing is returned.
@@ -238,13 +305,28 @@ pub enum PipelineError {
         source: Box<PipelineError>,
     },
     /// An improver failed with an error of its own.
-    #[error("improver `{improver}`: {message}")]
+    #[error("improver `{improver}`: {source}")]
     Improver {
         /// its name
         improver: &'static str,
-        /// what it said
-        message: String,
+        /// its error
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
     },
+}
+
+fn target_note(target: &TargetLength, l_avg: &f64) -> String {
+    match *target {
+        TargetLength::Factor(f) if f.is_finite() && f > 0.0 => format!(
+            "L_tar = {f} × L_avg, and the input's mean metric edge length L_avg is {l_avg} \
+             (a mesh too large or too small for its metric, or a vanishing metric)"
+        ),
+        TargetLength::Factor(f) => {
+            format!("the target factor (--ltar-factor) {f} is not a positive number")
+        }
+        TargetLength::Absolute(l) => {
+            format!("the absolute target (--ltar) {l} is not a positive number")
+        }
+    }
 }
 
 fn seed_note(seed: &Option<VertexId>) -> String {

@@ -78,11 +78,10 @@ fn patch_pass(
     rng: &mut crate::Rng,
 ) -> Result<PatchPass, PipelineError> {
     if targets.len() != state.work.mesh.n_faces() {
-        return Err(PipelineError::Input(format!(
-            "an improver gave {} target flags for {} faces",
-            targets.len(),
-            state.work.mesh.n_faces()
-        )));
+        return Err(PipelineError::ImproverTargets {
+            flags: targets.len(),
+            faces: state.work.mesh.n_faces(),
+        });
     }
     let mut pass = PatchPass::default();
     // The run's patch budget bounds the improvers' patches too; once Algorithm 1 spent it,
@@ -212,7 +211,7 @@ pub fn run(
                 Ok(own) => *own,
                 Err(other) => PipelineError::Improver {
                     improver: improver.name(),
-                    message: other.to_string(),
+                    source: other,
                 },
             })?;
         steps.push(ImproverRecord {

@@ -85,7 +85,10 @@ pub fn remesh(
 ) -> Result<RemeshResult, PipelineError> {
     for i in &stages.improvers {
         i.validate()
-            .map_err(|e| PipelineError::Input(format!("improver `{}`: {e}", i.name())))?;
+            .map_err(|source| PipelineError::ImproverOption {
+                improver: i.name(),
+                source,
+            })?;
     }
     let clock = Instant::now();
     let topo = certified_input_topology(field)?;
@@ -145,12 +148,7 @@ fn certified_input_topology(field: &MetricField) -> Result<Topology, PipelineErr
     let topo = Topology::build(reference);
     crate::invariants::certify_manifold(reference, &topo)
         .and_then(|()| crate::invariants::certify_oriented(reference, &topo))
-        .map_err(|e| {
-            PipelineError::Input(format!(
-                "the input mesh is not an oriented manifold: {e} (`conemesh remesh --repair`, \
-                 or `repair=True` in Python, orients it and cuts non-manifold edges and vertices)"
-            ))
-        })?;
+        .map_err(PipelineError::NotManifold)?;
     Ok(topo)
 }
 

@@ -5,6 +5,7 @@ use crate::features::FeatureRule;
 use crate::fidelity::FidelityOptions;
 use crate::improve::Improver;
 use crate::metric::SizeOptions;
+use crate::option_error::OptionError;
 use crate::param::Parameterizer;
 use crate::patches::PatchStrategy;
 use crate::registry::{MetricSizes, Params, Registry, RegistryError};
@@ -228,41 +229,43 @@ impl RemeshOptions {
     }
 
     /// Errors for option values no run can use, naming the option.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), OptionError> {
+        let out_of_range = |option, value, range| OptionError::OutOfRange {
+            option,
+            value,
+            range,
+        };
         if self.batch == 0 {
-            return Err("the patch batch must hold at least 1 patch".to_string());
+            return Err(OptionError::TooFew {
+                option: "the patch batch",
+                value: 0,
+                min: 1,
+            });
         }
         if self.work_budget.is_nan() || self.work_budget <= 0.0 {
-            return Err(format!(
-                "work budget {} is not a number > 0",
-                self.work_budget
-            ));
+            let w = self.work_budget;
+            return Err(out_of_range("work budget", w, "a number > 0"));
         }
         if self.face_budget.is_nan() || self.face_budget <= 0.0 {
-            return Err(format!(
-                "face budget {} is not a number > 0",
-                self.face_budget
-            ));
+            let f = self.face_budget;
+            return Err(out_of_range("face budget", f, "a number > 0"));
         }
         let eps = self.fidelity.max_deviation;
         if !(eps.is_finite() && eps >= 0.0) {
-            return Err(format!(
-                "fidelity tolerance {eps} is not a finite number ≥ 0"
-            ));
+            let range = "a finite number ≥ 0";
+            return Err(out_of_range("fidelity tolerance", eps, range));
         }
         if let Some(d) = self.corner_defect {
             if d.is_nan() || d <= 0.0 {
-                return Err(format!(
-                    "corner angle defect must be a positive number of radians, got {d}"
-                ));
+                let range = "a positive number of radians";
+                return Err(out_of_range("corner angle defect", d, range));
             }
         }
         self.sizes.validate()?;
         let b = self.boundary.corner_angle;
         if !(b.is_finite() && b > 0.0 && b <= 180.0) {
-            return Err(format!(
-                "boundary corner angle must be in (0, 180] degrees, got {b}"
-            ));
+            let range = "in (0, 180] degrees";
+            return Err(out_of_range("boundary corner angle", b, range));
         }
         self.features.validate()?;
         Ok(())

@@ -1,5 +1,7 @@
-//! The whole job in one call: a mesh in file units (and optionally a user metric in file
+//! Algorithm 1 in one call: a mesh in file units (and optionally a user metric in file
 //! units) in, a certified remeshed mesh in file units, its report and typed warnings out.
+//! The whole job around it (the repair of the input, the yardstick, the report document and
+//! the files) is `crate::job`'s.
 //!
 //! ```no_run
 //! use conemesh::pipeline::{RemeshOptions, Remesher};
@@ -140,11 +142,10 @@ impl Remesher {
     ) -> Result<Remeshed, PipelineError> {
         if let Some(m) = metric {
             if m.len() != input.n_vertices() {
-                return Err(PipelineError::Input(format!(
-                    "the metric has {} tensors for {} vertices",
-                    m.len(),
-                    input.n_vertices()
-                )));
+                return Err(PipelineError::MetricCount {
+                    tensors: m.len(),
+                    vertices: input.n_vertices(),
+                });
             }
         }
         certify_faces_at_vertices(input)?;
@@ -290,7 +291,11 @@ fn certify_faces_at_vertices(input: &TriMesh) -> Result<(), PipelineError> {
             faces[v.idx()] += 1;
         }
     }
-    match faces.iter().enumerate().max_by_key(|&(i, n)| (*n, std::cmp::Reverse(i))) {
+    match faces
+        .iter()
+        .enumerate()
+        .max_by_key(|&(i, n)| (*n, std::cmp::Reverse(i)))
+    {
         Some((v, &n)) if n > MAX_FACES_AT_VERTEX => Err(PipelineError::CrowdedVertex {
             vertex: VertexId::new(v),
             faces: n,

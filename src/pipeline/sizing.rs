@@ -59,58 +59,46 @@ impl Plan {
     ) -> Result<Plan, PipelineError> {
         let reference = field.reference();
         if reference.n_faces() == 0 {
-            return Err(PipelineError::Input("the input mesh has no faces".into()));
+            return Err(PipelineError::EmptyInput);
         }
-        options.validate().map_err(PipelineError::Input)?;
+        options.validate()?;
         let l_avg = crate::quality::edge_length_average(reference, field.vertex_metrics());
         let l_tar = match options.target {
             TargetLength::Factor(f) => f * l_avg,
             TargetLength::Absolute(l) => l,
         };
         if !(l_tar.is_finite() && l_tar > 0.0) {
-            // Name where the value came from: the option, or the input's own edge lengths
-            // (a mesh whose size over- or underflows, or a metric that vanishes).
-            let why = match options.target {
-                TargetLength::Factor(f) if f.is_finite() && f > 0.0 => format!(
-                    "L_tar = {f} × L_avg, and the input's mean metric edge length L_avg is {l_avg} \
-                     (a mesh too large or too small for its metric, or a vanishing metric)"
-                ),
-                TargetLength::Factor(f) => {
-                    format!("the target factor (--ltar-factor) {f} is not a positive number")
-                }
-                TargetLength::Absolute(l) => {
-                    format!("the absolute target (--ltar) {l} is not a positive number")
-                }
-            };
-            return Err(PipelineError::Input(format!(
-                "target edge length {l_tar} is not a positive finite number: {why}"
-            )));
+            // The error names where the value came from: the option, or the input's own edge
+            // lengths (a mesh whose size over- or underflows, or a metric that vanishes).
+            return Err(PipelineError::BadTarget {
+                l_tar,
+                target: options.target,
+                l_avg,
+            });
         }
-        let sized =
-            match options.sizes.any() {
-                true => {
-                    let m = apply_sizes(
-                        reference,
-                        field.vertex_metrics(),
-                        l_tar,
-                        1.0,
-                        &options.sizes,
-                    );
-                    Some(field.with_metrics(m).map_err(|e| {
-                        PipelineError::Input(format!("size-controlled metric: {e}"))
-                    })?)
-                }
-                false => None,
-            };
+        let sized = match options.sizes.any() {
+            true => {
+                let m = apply_sizes(
+                    reference,
+                    field.vertex_metrics(),
+                    l_tar,
+                    1.0,
+                    &options.sizes,
+                );
+                Some(field.with_metrics(m).map_err(PipelineError::SizedMetric)?)
+            }
+            false => None,
+        };
         let field = sized.as_ref().unwrap_or(field);
         let expected = expected_faces(reference, field.vertex_metrics(), &[], l_tar);
         // A target far below the input's size would run for hours and exhaust memory: refuse
         // it up front, naming the count.
         if expected.is_nan() || expected > MAX_EXPECTED_FACES {
-            return Err(PipelineError::Input(format!(
-                "target edge length {l_tar:e} is too small for this input: the output would have \
-                 about {expected:.3e} faces (more than {MAX_EXPECTED_FACES:e})"
-            )));
+            return Err(PipelineError::TargetTooSmall {
+                l_tar,
+                expected,
+                max: MAX_EXPECTED_FACES,
+            });
         }
         let (mut min_edge, mut fid_scale) = a_priori(field, topo, options, l_tar);
         let expected_fidelity =
@@ -160,7 +148,7 @@ impl Plan {
             Some(
                 field
                     .with_metrics(metrics)
-                    .map_err(|e| PipelineError::Input(format!("fidelity-scaled metric: {e}")))?,
+                    .map_err(PipelineError::FidelityMetric)?,
             )
         };
         Ok(Plan {

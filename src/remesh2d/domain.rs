@@ -82,17 +82,13 @@ pub fn triangulate_polygon_with(
 ) -> Result<(PlanarDomain, Vec<usize>), Remesh2dError> {
     let nb = boundary.len();
     if nb < 3 {
-        return Err(Remesh2dError::InvalidDomain(format!(
-            "polygon has {nb} vertices"
-        )));
+        return Err(Remesh2dError::ShortPolygon(nb));
     }
     let area2: f64 = (0..nb)
         .map(|i| boundary[i].coords.perp(&boundary[(i + 1) % nb].coords))
         .sum();
     if area2.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return Err(Remesh2dError::InvalidDomain(
-            "polygon is not counter-clockwise".into(),
-        ));
+        return Err(Remesh2dError::Clockwise);
     }
     let mut points: Vec<Point2<f64>> = boundary.to_vec();
     let inside = PolygonSlabs::new(boundary);
@@ -108,11 +104,9 @@ pub fn triangulate_polygon_with(
     let mut conflict = false;
     let cdt: ConstrainedDelaunayTriangulation<spade::Point2<f64>> =
         ConstrainedDelaunayTriangulation::try_bulk_load_cdt(verts, edges, |_| conflict = true)
-            .map_err(|e| Remesh2dError::InvalidDomain(format!("triangulation failed: {e:?}")))?;
+            .map_err(Remesh2dError::Triangulation)?;
     if conflict || cdt.num_vertices() != points.len() {
-        return Err(Remesh2dError::InvalidDomain(
-            "polygon self-intersects or has duplicate points".into(),
-        ));
+        return Err(Remesh2dError::SelfIntersecting);
     }
     let all: Vec<[u32; 3]> = cdt
         .inner_faces()
@@ -174,7 +168,6 @@ pub fn triangulate_polygon_with(
         triangles: dom.triangles.clone(),
         origin: (0..dom.points.len() as u32).map(Some).collect(),
     };
-    crate::invariants::certify_planar(&dom, &identity)
-        .map_err(|e| Remesh2dError::InvalidDomain(format!("triangulation: {e}")))?;
+    crate::invariants::certify_planar(&dom, &identity).map_err(Remesh2dError::InvalidDomain)?;
     Ok((dom, kept))
 }

@@ -4,6 +4,7 @@
 //! patch mesh").
 
 use super::{transfer::clamp_spd, Metric2d, Remesh2dError};
+use crate::ids::{FaceId, VertexId};
 use crate::predicates::{orient2d, Sign};
 use nalgebra::{Matrix2, Point2};
 
@@ -40,34 +41,29 @@ impl PlanarMetricField {
         metrics: Vec<Matrix2<f64>>,
     ) -> Result<Self, Remesh2dError> {
         if metrics.len() != points.len() {
-            return Err(Remesh2dError::InvalidDomain(format!(
-                "{} points but {} metrics",
-                points.len(),
-                metrics.len()
-            )));
+            return Err(Remesh2dError::CountMismatch {
+                elements: points.len(),
+                of: "points",
+                found: metrics.len(),
+                data: "metrics",
+            });
         }
         if triangles.is_empty() {
-            return Err(Remesh2dError::InvalidDomain("no triangles".into()));
+            return Err(Remesh2dError::NoTriangles);
         }
         if let Some(i) = points
             .iter()
             .position(|p| !p.x.is_finite() || !p.y.is_finite())
         {
-            return Err(Remesh2dError::InvalidDomain(format!(
-                "point v{i} is not finite"
-            )));
+            return Err(Remesh2dError::NonFinitePoint(VertexId::new(i)));
         }
         for (f, t) in triangles.iter().enumerate() {
             if t.iter().any(|&i| i as usize >= points.len()) {
-                return Err(Remesh2dError::InvalidDomain(format!(
-                    "triangle f{f} has an out-of-range vertex"
-                )));
+                return Err(Remesh2dError::VertexOutOfRange(FaceId::new(f)));
             }
             let [a, b, c] = t.map(|i| points[i as usize]);
             if orient2d(&a, &b, &c) != Sign::Positive {
-                return Err(Remesh2dError::InvalidDomain(format!(
-                    "triangle f{f} is not positively oriented"
-                )));
+                return Err(Remesh2dError::NotPositive(FaceId::new(f)));
             }
         }
         let metrics = metrics
@@ -134,11 +130,12 @@ impl PlanarMetricField {
         corners: Vec<[Matrix2<f64>; 3]>,
     ) -> Result<Self, Remesh2dError> {
         if corners.len() != self.triangles.len() {
-            return Err(Remesh2dError::InvalidDomain(format!(
-                "{} triangles but {} corner metric triples",
-                self.triangles.len(),
-                corners.len()
-            )));
+            return Err(Remesh2dError::CountMismatch {
+                elements: self.triangles.len(),
+                of: "triangles",
+                found: corners.len(),
+                data: "corner metric triples",
+            });
         }
         let mut clamped = Vec::with_capacity(corners.len());
         for (t, c) in self.triangles.iter().zip(&corners) {
@@ -363,9 +360,7 @@ mod tests {
         // Every vertex and every edge midpoint (exact in binary) is located, in a triangle
         // that contains it, and the lowest such triangle.
         for (i, p) in f.points().iter().enumerate() {
-            let (t, l) = f
-                .locate(p)
-                .ok_or(Remesh2dError::InvalidDomain(format!("v{i}")))?;
+            let (t, l) = f.locate(p).unwrap_or_else(|| panic!("v{i} is not located"));
             let first = (0..f.triangles().len()).find(|&k| f.contains(k, p));
             assert_eq!(Some(t), first, "v{i}");
             let k = f.triangles()[t].iter().position(|&v| v as usize == i);
@@ -378,9 +373,7 @@ mod tests {
                     f.points()[t[(k + 1) % 3] as usize],
                 );
                 let m = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
-                let (tri, l) = f
-                    .locate(&m)
-                    .ok_or(Remesh2dError::InvalidDomain("mid".into()))?;
+                let (tri, l) = f.locate(&m).expect("an edge midpoint is located");
                 assert!(f.contains(tri, &m));
                 assert_eq!(
                     Some(tri),
@@ -445,6 +438,6 @@ mod tests {
             Point2::new(1.0, 0.0),
         ];
         let r = PlanarMetricField::new(pts, vec![[0, 1, 2]], vec![Matrix2::identity(); 3]);
-        assert!(matches!(r, Err(Remesh2dError::InvalidDomain(s)) if s.contains("f0")));
+        assert!(matches!(r, Err(Remesh2dError::NotPositive(FaceId(0)))));
     }
 }

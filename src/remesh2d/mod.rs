@@ -20,6 +20,7 @@ pub use registry::{planar_remesher, REMESHERS};
 pub use stats::{planar_quality, PlanarQuality};
 pub use transfer::{clamp_spd, pullback_corners, transfer_metric, TransferMethod, EIGEN_FLOOR_REL};
 
+use crate::ids::{FaceId, VertexId};
 pub use crate::mesh::{PlanarDomain, PlanarMesh};
 use nalgebra::{Matrix2, Point2};
 use rand_chacha::ChaCha8Rng;
@@ -28,9 +29,52 @@ use thiserror::Error;
 /// Errors of planar remeshing.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum Remesh2dError {
-    /// The input domain is invalid (not a positively oriented disk triangulation, …).
+    /// The input domain fails its certificate (not a positively oriented disk triangulation,
+    /// …), naming the elements.
     #[error("invalid planar domain: {0}")]
-    InvalidDomain(String),
+    InvalidDomain(#[source] crate::invariants::InvariantError),
+    /// Per-element data whose count is not the element count.
+    #[error("{elements} {of} but {found} {data}")]
+    CountMismatch {
+        /// the element count
+        elements: usize,
+        /// which elements ("vertices", "points", "triangles")
+        of: &'static str,
+        /// the data's count
+        found: usize,
+        /// which data ("uv positions", "metrics", "corner metric triples")
+        data: &'static str,
+    },
+    /// A metric field over no triangles.
+    #[error("invalid planar domain: no triangles")]
+    NoTriangles,
+    /// A point with a NaN or infinite coordinate.
+    #[error("invalid planar domain: point {0} is not finite")]
+    NonFinitePoint(VertexId),
+    /// A triangle naming a point that does not exist.
+    #[error("invalid planar domain: triangle {0} has an out-of-range vertex")]
+    VertexOutOfRange(FaceId),
+    /// A triangle that is not positively oriented (exact).
+    #[error("invalid planar domain: triangle {0} is not positively oriented")]
+    NotPositive(FaceId),
+    /// A parameter triangle of zero area (no Jacobian for the metric's pull-back).
+    #[error("degenerate parameter triangle {0}")]
+    DegenerateParamTriangle(FaceId),
+    /// A boundary polygon of fewer than 3 vertices.
+    #[error("invalid planar domain: polygon has {0} vertices")]
+    ShortPolygon(usize),
+    /// A boundary polygon that is not counter-clockwise.
+    #[error("invalid planar domain: polygon is not counter-clockwise")]
+    Clockwise,
+    /// A boundary polygon that self-intersects or repeats a point.
+    #[error("invalid planar domain: polygon self-intersects or has duplicate points")]
+    SelfIntersecting,
+    /// The constrained Delaunay triangulation refused a point (NaN, too large or too small).
+    #[error("invalid planar domain: triangulation failed: {0:?}")]
+    Triangulation(spade::InsertionError),
+    /// A target edge length that is not a positive number.
+    #[error("target length {0} is not positive")]
+    BadTargetLength(f64),
     /// A metric value is not symmetric positive definite.
     #[error("metric not SPD at ({x}, {y})")]
     MetricNotSpd {

@@ -70,11 +70,7 @@ pub fn transfer_metric(
 ) -> Result<Vec<Matrix2<f64>>, Remesh2dError> {
     let n = disk.n_vertices();
     if uv.len() != n || metrics3d.len() != n {
-        return Err(Remesh2dError::InvalidDomain(format!(
-            "transfer_metric: {n} vertices but {} uv positions and {} metrics",
-            uv.len(),
-            metrics3d.len()
-        )));
+        return Err(count_mismatch(n, uv.len(), metrics3d.len()));
     }
     let raw = match method {
         TransferMethod::JacobianPullback => pullback(disk, uv, metrics3d)?,
@@ -104,11 +100,7 @@ pub fn pullback_corners(
 ) -> Result<Vec<[Matrix2<f64>; 3]>, Remesh2dError> {
     let n = disk.n_vertices();
     if uv.len() != n || metrics3d.len() != n {
-        return Err(Remesh2dError::InvalidDomain(format!(
-            "pullback_corners: {n} vertices but {} uv positions and {} metrics",
-            uv.len(),
-            metrics3d.len()
-        )));
+        return Err(count_mismatch(n, uv.len(), metrics3d.len()));
     }
     disk.faces()
         .map(|f| {
@@ -120,11 +112,7 @@ pub fn pullback_corners(
             let e2 = Matrix2::from_columns(&[uv[b] - uv[a], uv[c] - uv[a]]);
             let j = match e2.try_inverse() {
                 Some(inv) if e2.determinant() != 0.0 => e3 * inv,
-                _ => {
-                    return Err(Remesh2dError::InvalidDomain(format!(
-                        "pullback_corners: degenerate parameter triangle {f}"
-                    )))
-                }
+                _ => return Err(Remesh2dError::DegenerateParamTriangle(f)),
             };
             Ok([a, b, c].map(|v| j.transpose() * metrics3d[v] * j))
         })
@@ -151,11 +139,7 @@ fn pullback(
         // parameterization should have refused it already.
         let inv = match e2.try_inverse() {
             Some(inv) if area.is_finite() && area != 0.0 => inv,
-            _ => {
-                return Err(Remesh2dError::InvalidDomain(format!(
-                    "transfer_metric: degenerate parameter triangle {f}"
-                )))
-            }
+            _ => return Err(Remesh2dError::DegenerateParamTriangle(f)),
         };
         let j = e3 * inv;
         let w = area.abs();
@@ -236,6 +220,20 @@ fn principal_fit(
             Some(d * Matrix2::from_diagonal(&k) * d.transpose())
         })
         .collect()
+}
+
+/// The error of `n` vertices with `uv` positions and `metrics` tensors (one of them not `n`).
+fn count_mismatch(n: usize, uv: usize, metrics: usize) -> Remesh2dError {
+    let (found, data) = match uv != n {
+        true => (uv, "uv positions"),
+        false => (metrics, "metrics"),
+    };
+    Remesh2dError::CountMismatch {
+        elements: n,
+        of: "vertices",
+        found,
+        data,
+    }
 }
 
 #[cfg(test)]
@@ -369,6 +367,12 @@ mod tests {
     fn length_mismatch_is_an_error() {
         let (m, uv) = flat_disk();
         let r = transfer_metric(&m, &uv[1..], &[], TransferMethod::default());
-        assert!(matches!(r, Err(Remesh2dError::InvalidDomain(_))));
+        assert!(matches!(
+            r,
+            Err(Remesh2dError::CountMismatch {
+                data: "uv positions",
+                ..
+            })
+        ));
     }
 }

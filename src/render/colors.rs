@@ -6,6 +6,7 @@ use super::{RenderError, MAGENTA};
 use crate::ids::PatchId;
 use crate::mesh::{SurfaceProjector, TriMesh};
 use crate::metric::{validate_vertex_metric, MetricField, MetricOptions, Normalization};
+use crate::option_error::OptionError;
 use crate::quality::face_qualities;
 use nalgebra::{Matrix3, Point3};
 use rustc_hash::FxHashMap;
@@ -35,17 +36,18 @@ impl ColorBy {
     pub const NAMES: [&'static str; 5] = ["q", "min-angle", "patch", "distance", "none"];
 
     /// Reads one of [`ColorBy::NAMES`].
-    pub fn parse(s: &str) -> Result<ColorBy, String> {
+    pub fn parse(s: &str) -> Result<ColorBy, OptionError> {
         match s.trim() {
             "q" => Ok(ColorBy::Q),
             "min-angle" => Ok(ColorBy::MinAngle),
             "patch" => Ok(ColorBy::Patch),
             "distance" => Ok(ColorBy::Distance),
             "none" => Ok(ColorBy::None),
-            t => Err(format!(
-                "expected one of {}, got {t:?}",
-                ColorBy::NAMES.join(", ")
-            )),
+            t => Err(OptionError::Unparsed {
+                option: "color",
+                value: t.to_string(),
+                expected: "one of q, min-angle, patch, distance, none",
+            }),
         }
     }
 

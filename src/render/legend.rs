@@ -142,7 +142,7 @@ pub fn label_views(img: &mut Image, views: &[View]) -> Result<(), RenderError> {
 }
 
 fn draw_texts(img: &mut Image, texts: &Texts, size: u32) -> Result<(), RenderError> {
-    let err = |e: &dyn std::fmt::Display| RenderError::Encode(format!("drawing text: {e}"));
+    let err = |e: DrawingAreaErrorKind<_>| RenderError::Text(Box::new(e));
     let (w, h) = (img.width, img.height);
     let root = BitMapBackend::with_buffer(&mut img.rgb, (w, h)).into_drawing_area();
     for (s, x, y, hpos) in texts {
@@ -150,8 +150,8 @@ fn draw_texts(img: &mut Image, texts: &Texts, size: u32) -> Result<(), RenderErr
             .color(&BLACK)
             .pos(Pos::new(*hpos, VPos::Top));
         root.draw(&Text::new(s.clone(), (*x, *y), style))
-            .map_err(|e| err(&e))?;
+            .map_err(err)?;
     }
-    root.present().map_err(|e| err(&e))?;
+    root.present().map_err(err)?;
     Ok(())
 }

@@ -83,9 +83,12 @@ pub enum RenderError {
     /// estimate failed).
     #[error(transparent)]
     Metric(#[from] crate::metric::MetricError),
-    /// Encoding the PNG or drawing text failed.
+    /// Encoding the PNG failed.
     #[error("cannot encode the picture: {0}")]
-    Encode(String),
+    Encode(#[source] png::EncodingError),
+    /// Drawing the legend's text failed (plotters' error, boxed: its type names the backend).
+    #[error("cannot encode the picture: drawing text: {0}")]
+    Text(#[source] Box<dyn std::error::Error + Send + Sync>),
 }
 
 /// Whether the faces' edges are drawn.
@@ -171,11 +174,8 @@ impl Image {
             enc.set_color(png::ColorType::Rgb);
             enc.set_depth(png::BitDepth::Eight);
             enc.set_compression(png::Compression::Best);
-            let mut w = enc
-                .write_header()
-                .map_err(|e| RenderError::Encode(e.to_string()))?;
-            w.write_image_data(&self.rgb)
-                .map_err(|e| RenderError::Encode(e.to_string()))?;
+            let mut w = enc.write_header().map_err(RenderError::Encode)?;
+            w.write_image_data(&self.rgb).map_err(RenderError::Encode)?;
         }
         Ok(out)
     }

@@ -4,6 +4,7 @@
 use super::*;
 use crate::ids::PatchId;
 use crate::mesh::generators;
+use crate::option_error::OptionError;
 use nalgebra::{Matrix3, Point3, Vector3};
 
 /// No text: the pixel counts below do not depend on the system's fonts.
@@ -397,5 +398,13 @@ fn color_names_round_trip() {
     for n in ColorBy::NAMES {
         assert_eq!(ColorBy::parse(n).map(ColorBy::name), Ok(n));
     }
-    assert!(ColorBy::parse("quality").is_err());
+    match ColorBy::parse("quality") {
+        Err(OptionError::Unparsed {
+            value, expected, ..
+        }) => {
+            assert_eq!(value, "quality");
+            assert_eq!(expected, format!("one of {}", ColorBy::NAMES.join(", ")));
+        }
+        other => panic!("{other:?}"),
+    }
 }

@@ -6,7 +6,7 @@
 
 use super::super::sparse::Pattern;
 use super::ParamError;
-use crate::ids::VertexId;
+use crate::ids::{EdgeKey, VertexId};
 use nalgebra::{Point2, Vector2};
 
 /// The barrier of one disk's boundary.
@@ -82,9 +82,10 @@ impl BoundaryBarrier<'_> {
     ) -> Result<(), ParamError> {
         for (p, a, b, d) in self.active_pairs(uv) {
             if d <= 0.0 {
-                return Err(ParamError::NotCertified(format!(
-                    "boundary vertex v{p} touches boundary edge (v{a}, v{b})"
-                )));
+                return Err(ParamError::BoundaryTouch {
+                    vertex: VertexId::new(p),
+                    edge: EdgeKey::new(VertexId::new(a), VertexId::new(b)),
+                });
             }
             let r = self.eps / d;
             let d1 = self.weight * 2.0 * (r - 1.0) * (-r / d);

@@ -63,7 +63,10 @@ pub(super) fn initial_map_with(
     let clock = Instant::now();
     if options.free_boundary_init {
         let lscm = VertexSystem::get(system, disk)
-            .map_err(ParamError::Solver)
+            .map_err(|failure| ParamError::Solver {
+                system: crate::param::LinearSystem::VertexPattern,
+                failure,
+            })
             .and_then(|s| lscm_on(disk, boundary, s));
         if let Ok(mut uv) = lscm {
             scale_to_area(disk, &mut uv);

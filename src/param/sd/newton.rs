@@ -14,9 +14,9 @@ use super::energy::TwistFilter;
 use super::objective::Objective;
 use super::repair::{RepairPenalty, RepairStep};
 use super::SdOptions;
-use crate::ids::VertexId;
+use crate::ids::{FaceId, VertexId};
 use crate::mesh::TriMesh;
-use crate::param::{recertify, ParamError};
+use crate::param::{recertify, LinearSystem, ParamError};
 use faer::Mat;
 use nalgebra::Point2;
 use std::cell::OnceCell;
@@ -89,7 +89,10 @@ pub(super) fn newton(
         return Ok((uv0.to_vec(), log));
     }
     let mut clock = Lap::start();
-    let system = VertexSystem::get(system, disk).map_err(ParamError::Solver)?;
+    let system = VertexSystem::get(system, disk).map_err(|failure| ParamError::Solver {
+        system: LinearSystem::VertexPattern,
+        failure,
+    })?;
     let mut state = Newton::new(disk, options, mode, objective, system, uv0);
     state.log.time_ms[0] += clock.lap();
     state.start()?;
@@ -235,9 +238,17 @@ impl<'a> Newton<'a> {
         }
         self.energy = self.objective.energy(&self.uv);
         if !self.certified() && !self.energy.is_finite() {
-            return Err(ParamError::NotCertified(
-                "the start has a flipped or degenerate triangle".to_string(),
-            ));
+            let face = self.disk.triangles.iter().position(|t| {
+                let (a, b, c) = (
+                    self.uv[t[0].idx()],
+                    self.uv[t[1].idx()],
+                    self.uv[t[2].idx()],
+                );
+                (b - a).perp(&(c - a)) <= 0.0
+            });
+            return Err(ParamError::FlippedStart {
+                face: face.map(FaceId::new),
+            });
         }
         self.log.energies.push(self.energy);
         self.log
@@ -321,9 +332,10 @@ impl<'a> Newton<'a> {
             }
             mu *= 100.0;
         }
-        Err(ParamError::Solver(
-            "Newton Hessian is not positive definite".to_string(),
-        ))
+        Err(ParamError::Solver {
+            system: LinearSystem::NewtonHessian,
+            failure: crate::param::SolveFailure::NotPositiveDefinite,
+        })
     }
 
     /// The flip-free bound and, when certified, the boundary-collision bound over the steps

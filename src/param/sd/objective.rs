@@ -8,7 +8,7 @@ use super::super::sparse::Pattern;
 use super::barrier::BoundaryBarrier;
 use super::energy::{self, TwistFilter};
 use super::repair::RepairPenalty;
-use crate::ids::VertexId;
+use crate::ids::{FaceId, VertexId};
 use crate::param::ParamError;
 use nalgebra::Point2;
 
@@ -70,9 +70,10 @@ impl<'a> Objective<'a> {
                 continue;
             }
             let f = jacobian(fr, [uv[t[0].idx()], uv[t[1].idx()], uv[t[2].idx()]]);
-            let (_, gf, hf) = energy::derivatives(&f, twist_filter).ok_or_else(|| {
-                ParamError::NotCertified(format!("f{ti} is flipped during optimisation"))
-            })?;
+            let (_, gf, hf) =
+                energy::derivatives(&f, twist_filter).ok_or_else(|| ParamError::Flipped {
+                    face: FaceId::new(ti),
+                })?;
             let w = fr.area / self.total_area;
             let g = &fr.grad;
             // ∂vec(F)/∂u_{k,i}: entries (i, j) ↦ index 2i + j with coefficient G[k][j].

@@ -305,12 +305,9 @@ pub fn remesh_planar(
     rng: &mut ChaCha8Rng,
 ) -> Result<PlanarMesh, Remesh2dError> {
     if !(target_length.is_finite() && target_length > 0.0) {
-        return Err(Remesh2dError::InvalidDomain(format!(
-            "target length {target_length} is not positive"
-        )));
+        return Err(Remesh2dError::BadTargetLength(target_length));
     }
-    certify_planar(domain, &identity(domain))
-        .map_err(|e| Remesh2dError::InvalidDomain(e.to_string()))?;
+    certify_planar(domain, &identity(domain)).map_err(Remesh2dError::InvalidDomain)?;
     let max = options.max_faces;
     let ideal = super::ideal_faces(domain, metric, target_length);
     if ideal > max {
