@@ -195,6 +195,9 @@ fn assert_terminates(mesh: &TriMesh, seed: u64) {
             unprocessed: unprocessed.clone(),
             requests: requests.clone(),
         }),
+        // Algorithm 1's loop alone: the improvers take the run's strategy too (Algorithm 2's
+        // patches), and their requests are not the loop's.
+        improvers: Vec::new(),
         ..Stages::default()
     };
     let options = RemeshOptions {

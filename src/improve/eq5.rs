@@ -666,15 +666,19 @@ pub fn improve_planar(
     // boundary and constrained vertex stays.
     let mut new_id = vec![u32::MAX; n];
     let (mut points, mut origin) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    for v in 0..n {
+    for (v, id) in new_id.iter_mut().enumerate() {
         if s.star[v].is_empty() && !s.fixed[v] && counts.collapses > 0 {
             continue;
         }
-        new_id[v] = points.len() as u32;
+        *id = points.len() as u32;
         points.push(s.pts[v]);
         origin.push((!s.moved[v]).then_some(v as u32));
     }
-    let triangles = s.tris.iter().map(|t| t.map(|v| new_id[v as usize])).collect();
+    let triangles = s
+        .tris
+        .iter()
+        .map(|t| t.map(|v| new_id[v as usize]))
+        .collect();
     Ok((
         PlanarMesh {
             points,
@@ -809,7 +813,11 @@ mod tests {
     fn an_inner_vertex_no_move_can_place_well_is_collapsed() -> Result<(), Remesh2dError> {
         let dom = split_triangle();
         let (kept, counts) = improve_planar(&dom, &Iso, 2.0, &Eq5Options::default())?;
-        assert_eq!((counts.collapses, kept.triangles.len()), (0, 3), "off by default");
+        assert_eq!(
+            (counts.collapses, kept.triangles.len()),
+            (0, 3),
+            "off by default"
+        );
         let on = Eq5Options {
             collapse_below_deg: 30.0,
             ..Eq5Options::default()
@@ -818,10 +826,17 @@ mod tests {
         certify_planar(&dom, &out).expect("certified");
         assert_eq!(counts.collapses, 1, "{counts:?}");
         assert_eq!(out.triangles.len(), 1);
-        assert_eq!(out.points, dom.points[..3], "boundary kept bit for bit, inner vertex gone");
+        assert_eq!(
+            out.points,
+            dom.points[..3],
+            "boundary kept bit for bit, inner vertex gone"
+        );
         assert_eq!(out.origin, vec![Some(0), Some(1), Some(2)]);
         let (before, after) = (smallest_angle(&kept), smallest_angle(&out));
-        assert!(before < 19.4 && (after - 38.66).abs() < 0.01, "{before}° → {after}°");
+        assert!(
+            before < 19.4 && (after - 38.66).abs() < 0.01,
+            "{before}° → {after}°"
+        );
         Ok(())
     }
 

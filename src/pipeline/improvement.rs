@@ -12,8 +12,8 @@ use crate::improve::{ImproveRun, LoopStages, PatchPass, RunError, SurfaceContext
 use crate::metric::MetricField;
 use crate::quality::{face_qualities, stats_of, triangle_quality, TriangleQuality};
 use crate::stitch::{PatchVertex, Replacement, WorkingMesh};
-use std::time::Instant;
 use nalgebra::Point3;
+use std::time::Instant;
 
 /// The pipeline's side of [`crate::improve::ImproveRun`]: the run's context and state.
 struct Host<'r> {
@@ -158,7 +158,11 @@ fn keeps_the_surface(
         PatchVertex::Existing(u) => *work.mesh.position(u),
         PatchVertex::New(i) => candidate.new_positions[i as usize],
     };
-    let new: Vec<[Point3<f64>; 3]> = candidate.triangles.iter().map(|t| t.map(position)).collect();
+    let new: Vec<[Point3<f64>; 3]> = candidate
+        .triangles
+        .iter()
+        .map(|t| t.map(position))
+        .collect();
     let old: Vec<[Point3<f64>; 3]> = faces
         .iter()
         .map(|f| work.mesh.triangles[f.idx()].map(|v| work.mesh.positions[v.idx()]))
@@ -169,7 +173,9 @@ fn keeps_the_surface(
             .fold(f64::INFINITY, f64::min)
     };
     let vertices = faces.iter().flat_map(|f| work.mesh.triangles[f.idx()]);
-    vertices.clone().all(|v| distance(&work.mesh.positions[v.idx()], &new) <= tol)
+    vertices
+        .clone()
+        .all(|v| distance(&work.mesh.positions[v.idx()], &new) <= tol)
         && vertices
             .flat_map(|v| reference.triangles[work.locations[v.idx()].face.idx()])
             .all(|r| {
