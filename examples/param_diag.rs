@@ -35,7 +35,7 @@ fn main() {
         .unwrap_or_default();
     names.sort();
     for name in names {
-        let Ok(mesh) = load(&name) else { continue };
+        let mesh = load(&name);
         let mut rng = conemesh::Rng::seed_from_u64(1);
         let Ok(run) = cover(
             &mesh,

@@ -33,9 +33,12 @@ use serde_json::Value;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+// The shared-mesh catalogue, through `param_cover` below (which includes it too).
+use param_cover::catalogue as common;
+
 #[path = "common/cgal.rs"]
 mod cgal;
-use cgal::{repo, run_checker};
+use cgal::run_checker;
 
 // ---------------------------------------------------------------------------------------
 // Files: conemesh's own reader and writer (so the witness sees exactly the bytes conemesh
@@ -461,18 +464,7 @@ fn broken_corpus_agrees_with_cgal() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn shared_meshes_agree_with_cgal() {
-    let dir = repo().join("../shared/meshes");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("off" | "obj")))
-        .collect();
-    paths.sort();
-    assert!(
-        paths.len() >= 10,
-        "expected the shared meshes in {}",
-        dir.display()
-    );
+    let paths: Vec<PathBuf> = common::SHARED_MESHES.iter().map(|m| m.path()).collect();
     let mut diffs = Vec::new();
     for p in &paths {
         let m = read(p);
@@ -731,7 +723,7 @@ fn cover_patch_parameterizations_agree_with_cgal() {
     let dir = tempfile::tempdir().expect("tempdir");
     let (mut checked, mut overlapping_lscm) = (0, 0);
     for name in ["fertility.off", "stanford-bunny.obj"] {
-        let m = param_cover::load(name).expect("shared mesh");
+        let m = param_cover::load(name);
         let mut rng = conemesh::Rng::seed_from_u64(1);
         let run = cover(
             &m,

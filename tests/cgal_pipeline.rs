@@ -39,12 +39,14 @@ use conemesh::quality::approximation_error;
 use conemesh::{io, Topology, TriMesh};
 use rand::SeedableRng;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
+
+mod common;
 
 #[path = "common/cgal.rs"]
 mod cgal;
-use cgal::{repo, run_checker};
+use cgal::run_checker;
 
 // ---------------------------------------------------------------------------------------
 // The runs.
@@ -241,22 +243,18 @@ const GRID_FRACTION: f64 = 0.0005;
 /// Practical relative agreement of the two Hausdorff estimates (see the module docs).
 const AGREEMENT: f64 = 0.05;
 
-fn shared(name: &str) -> PathBuf {
-    repo().join("../shared/meshes").join(name)
-}
-
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn cgal_agrees_on_remeshed_fertility() {
     let dir = tempfile::tempdir().expect("tempdir");
-    cross_check("fertility", &shared("fertility.off"), dir.path());
+    cross_check("fertility", &common::path("fertility.off"), dir.path());
 }
 
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn cgal_agrees_on_remeshed_3holes() {
     let dir = tempfile::tempdir().expect("tempdir");
-    cross_check("3holes", &shared("3holes.off"), dir.path());
+    cross_check("3holes", &common::path("3holes.off"), dir.path());
 }
 
 #[test]

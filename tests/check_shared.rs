@@ -1,39 +1,23 @@
-//! `check` on every shared test mesh: genus and boundary loops as listed in
-//! `../shared/meshes/README.md`, and an insta snapshot of each check report (reviewable
-//! diff when a number changes). Heavy: run with `cargo test --release`.
+//! `check` on every shared test mesh: counts, genus, boundary loops and unreferenced vertices
+//! as the catalogue (`tests/common/mod.rs`) takes them from `../shared/meshes/README.md`, and
+//! an insta snapshot of each check report (reviewable diff when a number changes); the
+//! catalogue lists exactly the folder's meshes. Heavy: run with `cargo test --release`.
 
 use conemesh::check::{check_mesh, CheckOptions, CheckReport};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-const MESHES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes");
+mod common;
 
-/// Expected (genus, boundary loops, unreferenced vertices) per mesh, from the README table.
-const EXPECTED: &[(&str, u32, usize, usize)] = &[
-    ("3holes.off", 3, 0, 0),
-    ("armadillo.obj", 0, 0, 0),
-    ("bumpy.off", 0, 0, 0),
-    ("bunny.off", 0, 0, 0),
-    ("cow.off", 0, 0, 0),
-    ("decimated-knight.off", 0, 0, 0),
-    ("fandisk.off", 0, 0, 0),
-    ("fertility.off", 4, 0, 0),
-    ("homer.obj", 0, 0, 0),
-    ("screwdriver.off", 0, 0, 0),
-    ("spot.obj", 0, 0, 0),
-    ("stanford-bunny.obj", 0, 5, 1113),
-];
+use common::{shared_mesh, SHARED_MESHES};
 
 fn check(name: &str) -> CheckReport {
-    let path = Path::new(MESHES).join(name);
-    let loaded = conemesh::io::read_mesh(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
-    check_mesh(&loaded.mesh, &CheckOptions::default())
+    check_mesh(&common::load(name), &CheckOptions::default())
 }
 
 fn assert_readme_topology(name: &str, r: &CheckReport) {
-    let &(_, genus, loops, unreferenced) = EXPECTED
-        .iter()
-        .find(|e| e.0 == name)
-        .unwrap_or_else(|| panic!("{name} is not in EXPECTED"));
+    let m = shared_mesh(name);
+    let (genus, loops, unreferenced) = (m.genus, m.boundary_loops, m.unreferenced);
+    assert_eq!((r.vertices, r.faces), (m.vertices, m.faces), "{name}");
     assert_eq!(r.components, 1, "{name}");
     assert_eq!(r.component_list[0].genus, Some(genus), "{name}");
     assert_eq!(r.boundary_loops, loops, "{name}");
@@ -87,14 +71,14 @@ shared_mesh_tests! {
 /// Every mesh in the shared directory has a test above (a new mesh must be added).
 #[test]
 fn every_shared_mesh_is_covered() {
-    let mut found: Vec<String> = std::fs::read_dir(MESHES)
-        .expect("../shared/meshes exists")
+    let mut found: Vec<String> = std::fs::read_dir(common::dir())
+        .expect("the shared meshes directory is readable")
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p: &PathBuf| p.extension().is_some_and(|x| x != "md"))
         .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .collect();
     found.sort();
-    let expected: Vec<String> = EXPECTED.iter().map(|e| e.0.to_string()).collect();
+    let expected: Vec<String> = SHARED_MESHES.iter().map(|m| m.file.to_string()).collect();
     assert_eq!(found, expected);
 }
 
@@ -103,11 +87,12 @@ fn every_shared_mesh_is_covered() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn shared_meshes_validity() {
-    for &(name, ..) in EXPECTED {
+    for m in &SHARED_MESHES {
+        let name = m.file;
         let r = check(name);
         assert_eq!(r.degenerate_faces, 0, "{name}");
         let pairs = r.self_intersections.as_ref().map_or(0, |s| s.pairs);
-        if name == "cow.off" {
+        if m.self_intersects {
             assert!(!r.valid && pairs > 0, "{name}");
         } else {
             assert!(r.valid, "{name}: {r}");
@@ -136,7 +121,7 @@ fn cli_exit_codes_and_json() {
         out.contains("genus 1") && out.trim_end().ends_with("valid: yes"),
         "{out}"
     );
-    let cow = format!("{MESHES}/cow.off");
+    let cow = common::path("cow.off").display().to_string();
     let (code, out) = run_cli(&["--json", &cow]);
     assert_eq!(code, Some(1), "{out}");
     let v: serde_json::Value = serde_json::from_str(&out).expect("--json prints JSON");

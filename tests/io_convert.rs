@@ -5,6 +5,8 @@ use conemesh::io::read_mesh;
 use std::path::Path;
 use std::process::Command;
 
+mod common;
+
 fn convert(args: &[&std::ffi::OsStr]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_conemesh"))
         .arg("convert")
@@ -16,10 +18,7 @@ fn convert(args: &[&std::ffi::OsStr]) -> std::process::Output {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn convert_chain_keeps_the_mesh() {
-    let src = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/meshes/decimated-knight.off"
-    ));
+    let src = &common::path("decimated-knight.off");
     let original = read_mesh(src).expect("shared mesh").mesh;
     let tmp = tempfile::tempdir().expect("tempdir");
     let chain = [

@@ -4,9 +4,9 @@
 //! all shared meshes is `cargo run --release --example param_cover`.
 
 #[path = "common/param_cover.rs"]
-mod common;
+mod param_cover;
 
-use common::run_mesh;
+use param_cover::run_mesh;
 use std::collections::BTreeMap;
 
 fn r2(x: f64) -> f64 {

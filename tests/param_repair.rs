@@ -4,7 +4,7 @@
 //! Tutte map and needed 68–100 Newton iterations (p2 ran out of budget at mean σ1/σ2 1.31).
 
 #[path = "common/param_cover.rs"]
-mod common;
+mod param_cover;
 
 use conemesh::invariants::certify_bijective;
 use conemesh::param::{
@@ -16,7 +16,7 @@ use rand::SeedableRng;
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn hard_bunny_patches_start_from_the_repaired_lscm() {
-    let mesh = common::load("stanford-bunny.obj").expect("shared mesh");
+    let mesh = param_cover::load("stanford-bunny.obj");
     let mut rng = conemesh::Rng::seed_from_u64(1);
     let run = cover(
         &mesh,

@@ -12,7 +12,7 @@ use std::collections::VecDeque;
 use std::path::Path;
 use std::time::Instant;
 
-const MESHES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes");
+mod common;
 
 /// Tiny OFF / OBJ reader (positions and triangles; polygons fan-triangulated) so this test
 /// does not depend on `crate::io`.
@@ -151,18 +151,12 @@ fn r3(x: f64) -> f64 {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn k_ring_patches_of_shared_meshes_are_certified() {
-    let mut names: Vec<_> = std::fs::read_dir(MESHES)
-        .expect("shared meshes")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "off" || e == "obj"))
-        .collect();
-    names.sort();
     println!("| mesh | patches | faces | mean conformal (mean) | worst conformal | fallbacks | budget hit | ms / patch | iterations |");
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut rows = Vec::new();
-    for path in names {
-        let name = path.file_stem().unwrap().to_string_lossy().to_string();
-        let mesh = read(&path).without_unreferenced_vertices().0;
+    for m in &common::SHARED_MESHES {
+        let name = m.name().to_string();
+        let mesh = read(&m.path()).without_unreferenced_vertices().0;
         let topo = Topology::build(&mesh);
         let mut rng = conemesh::Rng::seed_from_u64(2024);
         let mut row = Row {

@@ -6,6 +6,8 @@ use conemesh::patches::{cover, ConePatches, CoverOptions};
 use rand::SeedableRng;
 use std::collections::BTreeMap;
 
+mod common;
+
 fn r3(x: f64) -> f64 {
     if x == 0.0 {
         return 0.0;
@@ -17,20 +19,10 @@ fn r3(x: f64) -> f64 {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn cone_patches_cover_every_shared_mesh() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes");
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .expect("shared meshes")
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().to_string())
-        .filter(|n| n.ends_with(".off") || n.ends_with(".obj"))
-        .collect();
-    names.sort();
-    assert!(names.len() >= 10);
     let mut snap = BTreeMap::new();
-    for name in names {
-        let loaded =
-            conemesh::io::read_mesh(&std::path::Path::new(dir).join(&name)).expect("readable mesh");
-        let mesh = loaded.mesh;
+    for m in &common::SHARED_MESHES {
+        let name = m.file.to_string();
+        let mesh = m.load();
         let mut rng = conemesh::Rng::seed_from_u64(1);
         let t0 = std::time::Instant::now();
         let run = cover(

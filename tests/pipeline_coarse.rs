@@ -8,20 +8,12 @@ use conemesh::pipeline::{
 };
 use conemesh::{mesh::generators, TriMesh};
 use rand::SeedableRng;
-use std::path::Path;
+
+mod common;
 
 fn unit_field(m: &TriMesh) -> MetricField {
     let unit = Normalization::of(m).apply(m);
     MetricField::from_curvature(unit, &MetricOptions::default()).expect("metric")
-}
-
-fn shared(name: &str) -> TriMesh {
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")).join(name);
-    conemesh::io::read_mesh(&path)
-        .unwrap_or_else(|e| panic!("{name}: {e}"))
-        .mesh
-        .without_unreferenced_vertices()
-        .0
 }
 
 /// The profile raises the sweeps, the rounds and persistence and lowers the floor, but never
@@ -79,7 +71,7 @@ fn on_forces_the_profile_and_auto_leaves_a_smooth_surface_alone() {
 #[cfg(not(debug_assertions))]
 #[test]
 fn persistent_factors_keep_the_knight_close() {
-    let f = unit_field(&shared("decimated-knight.off"));
+    let f = unit_field(&common::load_referenced("decimated-knight.off"));
     let with = RemeshOptions::default().coarse_profile();
     let mut without = with.clone();
     without.fidelity.persist = false;
@@ -106,22 +98,9 @@ fn persistent_factors_keep_the_knight_close() {
 #[cfg(not(debug_assertions))]
 #[test]
 fn only_the_knight_is_coarse() {
-    let names = [
-        "3holes.off",
-        "armadillo.obj",
-        "bumpy.off",
-        "bunny.off",
-        "cow.off",
-        "decimated-knight.off",
-        "fandisk.off",
-        "fertility.off",
-        "homer.obj",
-        "screwdriver.off",
-        "spot.obj",
-        "stanford-bunny.obj",
-    ];
-    for name in names {
-        let f = unit_field(&shared(name));
+    for m in &common::SHARED_MESHES {
+        let name = m.file;
+        let f = unit_field(&m.load_referenced());
         let (plain, fid, coarse) =
             coarse_input_estimate(&f, &RemeshOptions::default()).expect("estimate");
         let ratio = fid / plain;
@@ -138,7 +117,7 @@ fn only_the_knight_is_coarse() {
 #[cfg(not(debug_assertions))]
 #[test]
 fn off_gives_the_knight_the_paper_settings() {
-    let f = unit_field(&shared("decimated-knight.off"));
+    let f = unit_field(&common::load_referenced("decimated-knight.off"));
     let off = RemeshOptions {
         coarse_input: CoarseInput::Off,
         ..RemeshOptions::default()

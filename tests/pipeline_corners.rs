@@ -11,6 +11,8 @@ use conemesh::quality::approximation_error;
 use conemesh::{mesh::generators, TriMesh};
 use rand::SeedableRng;
 
+mod common;
+
 /// A unit-diagonal icosphere with vertex 0 pulled out into a spike (angle defect ≈ 4 rad).
 fn spiky_sphere() -> TriMesh {
     let mut m = generators::icosphere(1.0, 3);
@@ -123,9 +125,7 @@ fn a_strategy_that_swallows_a_corner_is_stopped_by_name() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn knight_spikes_are_kept() {
-    let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"))
-        .join("decimated-knight.off");
-    let mesh = conemesh::io::read_mesh(&path).expect("shared mesh").mesh;
+    let mesh = common::load("decimated-knight.off");
     let unit = Normalization::of(&mesh).apply(&mesh);
     let f = field(&unit);
     let topo = conemesh::Topology::build(&unit);

@@ -12,6 +12,8 @@ use conemesh::pipeline::{RemeshOptions, Remesher};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+
 fn remesh(input: &Path, out: &Path, seed: u64, threads: usize) -> Vec<u8> {
     let o = Command::new(env!("CARGO_BIN_EXE_conemesh"))
         .arg("remesh")
@@ -64,11 +66,7 @@ fn same_seed_same_bytes_on_a_generated_torus() {
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn same_seed_same_bytes_on_3holes() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let input = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/meshes/3holes.off"
-    ));
-    assert_reproducible(input, dir.path());
+    assert_reproducible(&common::path("3holes.off"), dir.path());
 }
 
 /// The library's output in a rayon pool of `threads` threads, as the bit patterns of its

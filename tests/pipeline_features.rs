@@ -13,7 +13,8 @@ use conemesh::pipeline::{remesh, PipelineError, RemeshOptions, Stages};
 use conemesh::quality::{evaluate, EvalOptions};
 use conemesh::{mesh::generators, Topology, TriMesh};
 use nalgebra::Point3;
-use std::path::Path;
+
+mod common;
 
 fn field(m: &TriMesh) -> MetricField {
     MetricField::from_curvature(m.clone(), &MetricOptions::default()).expect("metric")
@@ -140,15 +141,7 @@ fn a_bad_feature_angle_is_refused() {
 #[cfg(not(debug_assertions))]
 #[test]
 fn fandisk_keeps_its_sharp_edges() {
-    let path = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/meshes/fandisk.off"
-    ));
-    let file_mesh = conemesh::io::read_mesh(path)
-        .expect("fandisk")
-        .mesh
-        .without_unreferenced_vertices()
-        .0;
+    let file_mesh = common::load_referenced("fandisk.off");
     let norm = Normalization::of(&file_mesh);
     let unit = norm.apply(&file_mesh);
     let f = field(&unit);

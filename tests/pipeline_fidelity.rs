@@ -11,11 +11,7 @@ use conemesh::quality::approximation_error;
 use conemesh::TriMesh;
 use rand::SeedableRng;
 
-fn load(name: &str) -> TriMesh {
-    let path =
-        std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")).join(name);
-    conemesh::io::read_mesh(&path).expect("shared mesh").mesh
-}
+mod common;
 
 /// (two-sided Hausdorff / diagonal, output faces, fidelity rounds) of a default run with
 /// tolerance `eps`.
@@ -47,7 +43,7 @@ fn hausdorff(mesh: &TriMesh, eps: f64) -> (f64, usize, usize) {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn fidelity_control_keeps_the_screwdriver_tip() {
-    let mesh = load("screwdriver.off");
+    let mesh = common::load("screwdriver.off");
     let (off, f_off, r_off) = hausdorff(&mesh, 0.0);
     let (on, f_on, r_on) = hausdorff(&mesh, FidelityOptions::default().max_deviation);
     assert_eq!(r_off, 0, "max_deviation = 0 turns the rounds off");

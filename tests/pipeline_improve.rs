@@ -7,14 +7,10 @@ use conemesh::improve::{
     SurfacePasses,
 };
 use conemesh::invariants::certify_boundary_on_curves;
-use conemesh::mesh::{Topology, TriMesh};
+use conemesh::mesh::Topology;
 use conemesh::pipeline::{RemeshOptions, Remesher, Stages};
-use std::path::Path;
 
-fn shared(name: &str) -> TriMesh {
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")).join(name);
-    conemesh::io::read_mesh(&path).expect("shared mesh").mesh
-}
+mod common;
 
 /// The default stages with Algorithm 2 (threshold `q`) after the surface passes.
 fn with_improve(q: f64) -> Stages {
@@ -42,7 +38,7 @@ fn seeded(seed: u64) -> RemeshOptions {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn the_screwdriver_loses_small_angles_and_stays_certified() {
-    let input = shared("screwdriver.off");
+    let input = common::load("screwdriver.off");
     // Without feature lines: with the automatic rule Algorithm 1 alone already reaches θ_min
     // 20.9° on the screwdriver, and this test is about what Algorithm 2 does to small angles.
     let options = RemeshOptions {
@@ -192,7 +188,7 @@ fn an_improver_from_outside_the_crate_runs_certified_and_its_refusals_keep_the_m
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn same_seed_same_bytes_with_the_improvement() {
-    let input = shared("3holes.off");
+    let input = common::load("3holes.off");
     let run = || {
         Remesher::new(seeded(2))
             .with_stages(with_improve(0.8))

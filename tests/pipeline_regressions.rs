@@ -8,6 +8,8 @@ use serde_json::Value;
 use std::path::Path;
 use std::process::Command;
 
+mod common;
+
 fn remesh_cli(dir: &Path, tag: &str, extra: &[&str]) -> Value {
     let out = dir.join(format!("{tag}.obj"));
     let report = dir.join(format!("{tag}.json"));
@@ -66,15 +68,7 @@ fn absolute_ltar_is_the_same_length_in_the_run_and_in_the_evaluation() {
 /// input up front with a clear message.
 #[test]
 fn cow_with_a_self_intersecting_input_is_remeshed() {
-    let path = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/meshes/cow.off"
-    ));
-    let mesh = conemesh::io::read_mesh(path)
-        .expect("cow.off")
-        .mesh
-        .without_unreferenced_vertices()
-        .0;
+    let mesh = common::load_referenced("cow.off");
     assert!(
         !conemesh::invariants::self_intersections(&mesh).is_empty(),
         "the premise: cow.off self-intersects"

@@ -10,10 +10,11 @@ use conemesh::invariants::{certify_boundary_on_curves, certify_same_topology, se
 use conemesh::metric::{MetricField, MetricOptions, Normalization};
 use conemesh::pipeline::{remesh, RemeshOptions, RemeshReport, Stages};
 use conemesh::quality::{evaluate, flips, EvalOptions, EvalReport};
-use conemesh::{Topology, TriMesh};
+use conemesh::Topology;
 use sha2::{Digest, Sha256};
-use std::path::Path;
 use std::time::Instant;
+
+mod common;
 
 const SEED: u64 = 1;
 
@@ -26,14 +27,6 @@ fn r3(x: f64) -> f64 {
     (x * m).round() / m
 }
 
-fn shared(name: &str) -> TriMesh {
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")).join(name);
-    let loaded = conemesh::io::read_mesh(&path)
-        .unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
-    // As `conemesh remesh` does: unreferenced vertices carry no surface.
-    loaded.mesh.without_unreferenced_vertices().0
-}
-
 fn sha256_hex(bytes: &[u8]) -> String {
     Sha256::digest(bytes)
         .iter()
@@ -41,10 +34,12 @@ fn sha256_hex(bytes: &[u8]) -> String {
         .collect()
 }
 
-/// Run the pipeline on one shared mesh, assert every certificate, snapshot the summary;
-/// returns the run's report and the evaluation of its file-unit output.
-fn remesh_shared(name: &str, boundary_loops: usize) -> (RemeshReport, EvalReport) {
-    let file_mesh = shared(name);
+/// Run the pipeline on one shared mesh, assert every certificate (and the catalogue's
+/// boundary loops on input and output), snapshot the summary; returns the run's report and
+/// the evaluation of its file-unit output.
+fn remesh_shared(name: &str) -> (RemeshReport, EvalReport) {
+    let boundary_loops = common::shared_mesh(name).boundary_loops;
+    let file_mesh = common::load_referenced(name);
     let input_topo = Topology::build(&file_mesh);
     assert_eq!(
         input_topo.boundary_loops().len(),
@@ -193,28 +188,25 @@ fn remesh_shared(name: &str, boundary_loops: usize) -> (RemeshReport, EvalReport
     (result.report, eval)
 }
 
-#[test]
-#[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
-fn fertility_end_to_end() {
-    remesh_shared("fertility.off", 0);
+/// One release-only test per mesh, so that they run in parallel.
+macro_rules! end_to_end_tests {
+    ($($test:ident => $file:literal),* $(,)?) => {
+        $(
+            #[test]
+            #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
+            fn $test() {
+                remesh_shared($file);
+            }
+        )*
+    };
 }
 
-#[test]
-#[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
-fn three_holes_end_to_end() {
-    remesh_shared("3holes.off", 0);
-}
-
-#[test]
-#[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
-fn screwdriver_end_to_end() {
-    remesh_shared("screwdriver.off", 0);
-}
-
-#[test]
-#[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
-fn stanford_bunny_keeps_its_five_open_boundaries() {
-    remesh_shared("stanford-bunny.obj", 5);
+end_to_end_tests! {
+    fertility_end_to_end => "fertility.off",
+    three_holes_end_to_end => "3holes.off",
+    screwdriver_end_to_end => "screwdriver.off",
+    // The catalogue's 5 open boundary loops, kept.
+    stanford_bunny_keeps_its_five_open_boundaries => "stanford-bunny.obj",
 }
 
 /// decimated-knight (1,000 faces, piecewise flat): the run finds that the distance tolerance,
@@ -224,7 +216,7 @@ fn stanford_bunny_keeps_its_five_open_boundaries() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn decimated_knight_meets_the_targets_with_the_coarse_profile() {
-    let (r, eval) = remesh_shared("decimated-knight.off", 0);
+    let (r, eval) = remesh_shared("decimated-knight.off");
     assert!(r.coarse_input, "the coarse-input profile ran");
     assert!(r.expected_faces_fidelity >= 2.0 * r.expected_faces);
     assert_eq!(r.options.sweeps, 3);

@@ -12,7 +12,8 @@ use conemesh::pipeline::{
 use conemesh::quality::face_qualities;
 use conemesh::suite::ANALYTIC;
 use nalgebra::{Matrix3, Point3};
-use std::path::Path;
+
+mod common;
 
 fn run(mesh: &TriMesh, metric: Option<&[Matrix3<f64>]>) -> Remeshed {
     let options = RemeshOptions {
@@ -119,8 +120,7 @@ fn check_small_angles(name: &str, out: &Remeshed) -> [usize; 4] {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn the_report_names_every_face_below_20_degrees_and_its_cause() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/fandisk.off");
-    let fandisk = conemesh::io::read_mesh(&path).expect("fandisk").mesh;
+    let fandisk = common::load("fandisk.off");
     let fandisk_counts = check_small_angles("fandisk", &run(&fandisk, None));
     let case = ANALYTIC
         .iter()

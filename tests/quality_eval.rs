@@ -4,27 +4,8 @@
 
 use conemesh::quality::{evaluate, EvalOptions};
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 
-fn meshes_dir() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"))
-}
-
-/// The catalogue of shared meshes (name, file).
-const CATALOGUE: &[(&str, &str)] = &[
-    ("3holes", "3holes.off"),
-    ("armadillo", "armadillo.obj"),
-    ("bumpy", "bumpy.off"),
-    ("bunny", "bunny.off"),
-    ("cow", "cow.off"),
-    ("decimated-knight", "decimated-knight.off"),
-    ("fandisk", "fandisk.off"),
-    ("fertility", "fertility.off"),
-    ("homer", "homer.obj"),
-    ("screwdriver", "screwdriver.off"),
-    ("spot", "spot.obj"),
-    ("stanford-bunny", "stanford-bunny.obj"),
-];
+mod common;
 
 fn r3(x: f64) -> String {
     format!("{x:.3}")
@@ -34,8 +15,9 @@ fn r3(x: f64) -> String {
 #[cfg_attr(debug_assertions, ignore = "heavy: run with cargo test --release")]
 fn eval_of_every_shared_mesh_against_itself() -> anyhow::Result<()> {
     let mut rows = BTreeMap::new();
-    for (name, file) in CATALOGUE {
-        let mesh = conemesh::io::read_mesh(&meshes_dir().join(file))?.mesh;
+    for m in &common::SHARED_MESHES {
+        let name = m.name();
+        let mesh = m.load();
         let opts = EvalOptions {
             samples: 20_000,
             ..EvalOptions::default()
@@ -85,7 +67,7 @@ fn eval_of_every_shared_mesh_against_itself() -> anyhow::Result<()> {
 #[test]
 fn cli_eval_prints_a_row_and_writes_json_and_plots() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
-    let knight = meshes_dir().join("decimated-knight.off");
+    let knight = common::path("decimated-knight.off");
     let json = dir.path().join("r.json");
     let plots = dir.path().join("plots");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_conemesh"))

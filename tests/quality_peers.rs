@@ -10,6 +10,8 @@ use conemesh::quality::{evaluate, EvalOptions};
 use nalgebra::{Matrix3, Vector3};
 use std::path::PathBuf;
 
+mod common;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -115,8 +117,7 @@ const PEERS: &[PeerRow] = &[
 #[test]
 fn input_rows_match_the_independent_evaluator_with_the_libigl_metric() -> anyhow::Result<()> {
     for row in PEERS {
-        let path = root().join(format!("../shared/meshes/{}.off", row.name));
-        let mesh = conemesh::io::read_mesh(&path)?.mesh;
+        let mesh = common::load(&format!("{}.off", row.name));
         let norm = Normalization::of(&mesh);
         let metric = libigl_metric(row.name, &mesh, &norm)?;
         let opts = EvalOptions {

@@ -8,6 +8,8 @@ use nalgebra::{Matrix3, Vector3};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+mod common;
+
 /// One command-line argument (a path or a string).
 type Arg<'a> = &'a dyn AsRef<std::ffi::OsStr>;
 
@@ -308,11 +310,7 @@ fn the_patch_property_of_a_patches_ply_is_drawn_without_a_patch_file() {
 /// A shared mesh, coloured by q against itself and by distance to itself.
 #[test]
 fn a_shared_mesh_is_drawn() {
-    let mesh = Path::new("/work/shared/meshes/bumpy.off");
-    if !mesh.exists() {
-        eprintln!("skipped: {} not found", mesh.display());
-        return;
-    }
+    let mesh = &common::path("bumpy.off");
     let dir = tempfile::tempdir().expect("tempdir");
     let pic = dir.path().join("bumpy.png");
     ok(&conemesh(&[

@@ -12,11 +12,16 @@ use conemesh::patches::{cover, extract_patch, ConePatches, CoverOptions};
 use conemesh::TriMesh;
 use rand::SeedableRng;
 use serde::Serialize;
-use std::path::Path;
 use std::time::Instant;
 
+/// The shared-mesh catalogue (`tests/common/mod.rs`), here too for the examples that include
+/// this file.
+#[path = "mod.rs"]
+pub mod catalogue;
+
 /// The shared test meshes directory.
-pub const MESHES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes");
+#[allow(unused_imports)]
+pub use catalogue::DIR as MESHES;
 
 /// One patch of a covering run, parameterized.
 #[derive(Clone, Debug, Serialize)]
@@ -93,13 +98,11 @@ impl MeshRun {
     }
 }
 
-/// Read `name` from the shared meshes, drop unreferenced vertices, normalize to unit
+/// Read the shared mesh `name` ("bunny.off"), drop unreferenced vertices, normalize to unit
 /// bounding-box diagonal.
-pub fn load(name: &str) -> Result<TriMesh, String> {
-    let loaded = conemesh::io::read_mesh(&Path::new(MESHES).join(name))
-        .map_err(|e| format!("{name}: {e}"))?;
-    let (m, _) = loaded.mesh.without_unreferenced_vertices();
-    Ok(Normalization::of(&m).apply(&m))
+pub fn load(name: &str) -> TriMesh {
+    let m = catalogue::load_referenced(name);
+    Normalization::of(&m).apply(&m)
 }
 
 /// Parameterize and certify one patch (given by its faces) of `mesh`.
@@ -138,7 +141,7 @@ pub fn param_patch(mesh: &TriMesh, patch: usize, faces: &[conemesh::FaceId]) -> 
 /// Cover `name` (cone patches, seed 1) and parameterize every patch. Also returns the mesh
 /// and the patches' faces (for re-timing).
 pub fn run_mesh(name: &str) -> Result<(MeshRun, TriMesh, Vec<Vec<conemesh::FaceId>>), String> {
-    let mesh = load(name)?;
+    let mesh = load(name);
     let mut rng = conemesh::Rng::seed_from_u64(1);
     let t0 = Instant::now();
     let run = cover(
