@@ -127,6 +127,186 @@ impl fmt::Debug for EdgeKey {
     }
 }
 
+/// A value per element, indexed by the element's typed id: per-face state is a
+/// [`FaceMap`], per-vertex state a [`VertexMap`]. The working mesh's arrays change in two
+/// ways only, and these are the map's operations: new elements are appended
+/// ([`IdMap::push`], [`IdMap::extend`]) and removed ones dropped with the others' order kept
+/// ([`IdMap::drop_marked`], [`IdMap::compact`]), so every map kept in step with a mesh
+/// follows it the same way.
+#[derive(Clone, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct IdMap<I, T> {
+    values: Vec<T>,
+    #[serde(skip)]
+    id: std::marker::PhantomData<fn(I) -> I>,
+}
+
+/// A value per face, indexed by [`FaceId`].
+pub type FaceMap<T> = IdMap<FaceId, T>;
+/// A value per vertex, indexed by [`VertexId`].
+pub type VertexMap<T> = IdMap<VertexId, T>;
+
+/// An id that indexes an [`IdMap`].
+pub trait ElementId: Copy {
+    /// The id as an array index.
+    fn index(self) -> usize;
+}
+
+impl ElementId for FaceId {
+    #[inline]
+    fn index(self) -> usize {
+        self.idx()
+    }
+}
+
+impl ElementId for VertexId {
+    #[inline]
+    fn index(self) -> usize {
+        self.idx()
+    }
+}
+
+impl<I, T> IdMap<I, T> {
+    /// The map holding `values`, the value of element `i` at position `i`.
+    pub fn from_vec(values: Vec<T>) -> Self {
+        IdMap {
+            values,
+            id: std::marker::PhantomData,
+        }
+    }
+
+    /// `n` elements, each with `value`.
+    pub fn filled(n: usize, value: T) -> Self
+    where
+        T: Clone,
+    {
+        Self::from_vec(vec![value; n])
+    }
+
+    /// The values in element order.
+    pub fn into_vec(self) -> Vec<T> {
+        self.values
+    }
+
+    /// The values in element order.
+    pub fn as_slice(&self) -> &[T] {
+        &self.values
+    }
+
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// No element.
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    /// The values in element order.
+    pub fn iter(&self) -> std::slice::Iter<'_, T> {
+        self.values.iter()
+    }
+
+    /// The values in element order.
+    pub fn iter_mut(&mut self) -> std::slice::IterMut<'_, T> {
+        self.values.iter_mut()
+    }
+
+    /// The values in element order.
+    pub fn as_mut_slice(&mut self) -> &mut [T] {
+        &mut self.values
+    }
+
+    /// A new element's value (its id is the old length).
+    pub fn push(&mut self, value: T) {
+        self.values.push(value);
+    }
+
+    /// Drop the elements marked in `gone` (`gone[i]`: element `i` is removed), keeping the
+    /// others in order: their ids shift down past the removed ones, as the faces' do when a
+    /// patch is stitched.
+    pub fn drop_marked(&mut self, gone: &[bool]) {
+        debug_assert!(gone.len() >= self.values.len());
+        let mut k = 0;
+        self.values.retain(|_| {
+            k += 1;
+            !gone[k - 1]
+        });
+    }
+}
+
+impl<I: ElementId, T> IdMap<I, T> {
+    /// The value of element `id`, `None` past the end.
+    #[inline]
+    pub fn get(&self, id: I) -> Option<&T> {
+        self.values.get(id.index())
+    }
+
+    /// Follow an old → new id map that keeps the order (`map[old]`: the element's new id,
+    /// `None`: dropped), as [`crate::mesh::TriMesh::without_unreferenced_vertices`] makes;
+    /// a kept element past the end of the values gets `fill`.
+    pub fn compact(&mut self, map: &[Option<I>], fill: T)
+    where
+        T: Clone,
+    {
+        self.values.resize(map.len(), fill);
+        let mut old = 0;
+        self.values.retain(|_| {
+            old += 1;
+            debug_assert!(map[old - 1].is_none_or(|n| n.index() < old));
+            map[old - 1].is_some()
+        });
+    }
+}
+
+impl<I, T> Default for IdMap<I, T> {
+    fn default() -> Self {
+        Self::from_vec(Vec::new())
+    }
+}
+
+impl<I, T: fmt::Debug> fmt::Debug for IdMap<I, T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(&self.values, f)
+    }
+}
+
+impl<I: ElementId, T> std::ops::Index<I> for IdMap<I, T> {
+    type Output = T;
+    #[inline]
+    fn index(&self, id: I) -> &T {
+        &self.values[id.index()]
+    }
+}
+
+impl<I: ElementId, T> std::ops::IndexMut<I> for IdMap<I, T> {
+    #[inline]
+    fn index_mut(&mut self, id: I) -> &mut T {
+        &mut self.values[id.index()]
+    }
+}
+
+impl<I, T> FromIterator<T> for IdMap<I, T> {
+    fn from_iter<It: IntoIterator<Item = T>>(iter: It) -> Self {
+        Self::from_vec(iter.into_iter().collect())
+    }
+}
+
+impl<I, T> Extend<T> for IdMap<I, T> {
+    fn extend<It: IntoIterator<Item = T>>(&mut self, iter: It) {
+        self.values.extend(iter);
+    }
+}
+
+impl<'a, I, T> IntoIterator for &'a IdMap<I, T> {
+    type Item = &'a T;
+    type IntoIter = std::slice::Iter<'a, T>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.values.iter()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -151,5 +331,31 @@ mod tests {
         assert_eq!(h.next(), HalfedgeId::of(FaceId(5), 0));
         assert_eq!(h.prev(), HalfedgeId::of(FaceId(5), 1));
         assert_eq!(h.next().next().next(), h);
+    }
+
+    #[test]
+    fn id_maps_follow_removals_and_compaction() {
+        let mut faces: FaceMap<char> = "abcde".chars().collect();
+        faces.drop_marked(&[false, true, false, true, false]);
+        assert_eq!(faces.as_slice(), &['a', 'c', 'e']);
+        faces.push('f');
+        assert_eq!(faces[FaceId(3)], 'f');
+        assert_eq!(faces.get(FaceId(4)), None);
+        let mut vertices: VertexMap<u32> = VertexMap::from_vec(vec![10, 11, 12, 13]);
+        let map = [Some(VertexId(0)), None, Some(VertexId(1))];
+        vertices.compact(&map, 0);
+        assert_eq!(
+            vertices.as_slice(),
+            &[10, 12],
+            "past the map's end: dropped"
+        );
+        vertices[VertexId(1)] += 1;
+        assert_eq!(vertices.as_slice(), &[10, 13]);
+        vertices.compact(&[None, Some(VertexId(0)), Some(VertexId(1))], 1);
+        assert_eq!(
+            vertices.into_vec(),
+            vec![13, 1],
+            "kept past the values' end: filled"
+        );
     }
 }

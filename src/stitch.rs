@@ -8,7 +8,7 @@
 //! elements are stable while the loop runs.
 
 use crate::boundary::CurvePoint;
-use crate::ids::{FaceId, VertexId};
+use crate::ids::{FaceId, FaceMap, VertexId};
 use crate::mesh::{SurfaceLocation, TriMesh};
 use nalgebra::Point3;
 use thiserror::Error;
@@ -38,7 +38,7 @@ pub struct WorkingMesh {
     /// `locations[v]`: where vertex `v` lies on the reference mesh.
     pub locations: Vec<SurfaceLocation>,
     /// `processed[f]`: face `f` was produced by (or lies inside) an already remeshed patch.
-    pub processed: Vec<bool>,
+    pub processed: FaceMap<bool>,
     /// `curve[v]`: where vertex `v` lies on the input's boundary curves, for boundary
     /// vertices ([`crate::boundary`]); `None` inside.
     pub curve: Vec<Option<CurvePoint>>,
@@ -92,7 +92,7 @@ impl WorkingMesh {
         WorkingMesh {
             mesh: reference.clone(),
             locations,
-            processed: vec![false; reference.n_faces()],
+            processed: FaceMap::filled(reference.n_faces(), false),
             curve: vec![None; reference.n_vertices()],
         }
     }
@@ -188,7 +188,7 @@ pub fn stitch_all(
     for (f, gone) in remove.iter().enumerate() {
         if !gone {
             triangles.push(work.mesh.triangles[f]);
-            processed.push(work.processed[f]);
+            processed.push(work.processed[FaceId::new(f)]);
         }
     }
     let mut new_faces = Vec::with_capacity(patches.len());
@@ -199,7 +199,7 @@ pub fn stitch_all(
     }
     processed.resize(triangles.len(), true);
     work.mesh.triangles = triangles;
-    work.processed = processed;
+    work.processed = FaceMap::from_vec(processed);
     for (_, replacement) in patches {
         work.mesh
             .positions
@@ -246,7 +246,7 @@ mod tests {
         let new_faces = stitch(&mut w, &fan, &repl).expect("valid replacement");
         assert_eq!(new_faces.len(), 6);
         assert_eq!(w.unprocessed(), before_unprocessed - 6);
-        assert!(new_faces.iter().all(|f| w.processed[f.idx()]));
+        assert!(new_faces.iter().all(|&f| w.processed[f]));
         let t = Topology::build(&w.mesh);
         assert!(t.is_oriented_manifold());
         assert_eq!(t.components()[0].euler, 1);

@@ -540,11 +540,7 @@ impl<'a> Collapser<'a> {
             k += 1;
             !self.dead[k - 1]
         });
-        let mut k = 0;
-        work.processed.retain(|_| {
-            k += 1;
-            !self.dead[k - 1]
-        });
+        work.processed.drop_marked(&self.dead);
     }
 }
 

@@ -8,7 +8,7 @@ use super::sizing::Plan;
 use crate::boundary::BoundaryCurves;
 use crate::features::FeatureLines;
 use crate::fidelity::VertexFactors;
-use crate::ids::{EdgeKey, PatchId, VertexId};
+use crate::ids::{EdgeKey, FaceMap, PatchId, VertexId, VertexMap};
 use crate::improve::{Improver, LoopStages};
 use crate::invariants::{self, FlipTest, TopologySignature};
 use crate::mesh::Topology;
@@ -186,16 +186,16 @@ pub struct LoopState {
     /// The feature lines split into it before the loop.
     pub features: FeatureLines,
     /// `pinned[v]`: corners and feature-line vertices, which no pass moves.
-    pub pinned: Vec<bool>,
+    pub pinned: VertexMap<bool>,
     /// The fidelity factor per working-mesh vertex (carried between patches with
     /// [`crate::fidelity::FidelityOptions::persist`]).
     pub factors: VertexFactors,
     /// By how much the fidelity control scaled the metric where each working-mesh vertex was
     /// made (the a-priori factor at its location times its patch's rounds): above 1 the
     /// tolerance, not the metric, set the size there.
-    pub bound: Vec<f64>,
+    pub bound: VertexMap<f64>,
     /// Which patch produced each working-mesh face (`None`: an input face).
-    pub face_patch: Vec<Option<PatchId>>,
+    pub face_patch: FaceMap<Option<PatchId>>,
     /// Faces of the working mesh when the loop started (one sweep's work).
     pub faces_per_sweep: usize,
     /// The share of the run's expected output this loop makes (1; a region's faces over
@@ -333,13 +333,13 @@ impl LoopState {
         work: WorkingMesh,
         topo: Topology,
         features: FeatureLines,
-        pinned: Vec<bool>,
-        bound: Vec<f64>,
+        pinned: VertexMap<bool>,
+        bound: VertexMap<f64>,
     ) -> LoopState {
         LoopState {
             bound,
             factors: VertexFactors::ones(work.mesh.n_vertices()),
-            face_patch: vec![None; work.mesh.n_faces()],
+            face_patch: FaceMap::filled(work.mesh.n_faces(), None),
             faces_per_sweep: work.mesh.n_faces(),
             budget_share: 1.0,
             sweep: 1,
@@ -451,12 +451,24 @@ impl LoopState {
             .collect()
     }
 
+    /// Every per-face and per-vertex map of the loop has one entry per element of the
+    /// working mesh (checked after each stitched batch in debug builds).
+    pub fn in_step(&self) -> bool {
+        let (nv, nf) = (self.work.mesh.n_vertices(), self.work.mesh.n_faces());
+        self.work.locations.len() == nv
+            && self.work.curve.len() == nv
+            && self.work.processed.len() == nf
+            && self.bound.len() == nv
+            && self.pinned.len() == nv
+            && self.face_patch.len() == nf
+    }
+
     /// What the strategy sees.
     pub fn patch_context<'s>(&'s self, ctx: &'s RunContext<'_>) -> PatchContext<'s> {
         PatchContext {
             mesh: &self.work.mesh,
             topology: &self.topo,
-            processed: &self.work.processed,
+            processed: self.work.processed.as_slice(),
             feature_edges: self.feature_edges(),
             corners: Some(&ctx.corners),
             blocked: (!self.blocked.is_empty()).then_some(&self.blocked[..]),

@@ -22,15 +22,13 @@ pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(),
     certify_whole(ctx, state)?;
     let kinds = vertex_kinds(ctx, state);
     let map = state.work.compact();
-    let mut bound = vec![1.0; state.work.mesh.n_vertices()];
+    state.bound.compact(&map, 1.0);
     state.vertex_kinds = vec![VertexKind::Interior; state.work.mesh.n_vertices()];
     for (old, new) in map.iter().enumerate() {
         if let Some(n) = new {
-            bound[n.idx()] = state.bound.get(old).copied().unwrap_or(1.0);
             state.vertex_kinds[n.idx()] = kinds[old];
         }
     }
-    state.bound = bound;
     let t0 = Instant::now();
     if ctx.plan.options.check_self_intersections {
         let pairs = invariants::self_intersections(&state.work.mesh);
@@ -204,7 +202,7 @@ fn sizes_on_target(ctx: &RunContext<'_>, state: &LoopState) -> Sizes {
     use crate::quality::edge_conformity_where;
     let mesh = &state.work.mesh;
     let metrics = state.vertex_metrics(ctx);
-    let free = |v: VertexId| state.bound.get(v.idx()).copied().unwrap_or(1.0) <= 1.0 + 1e-9;
+    let free = |v: VertexId| state.bound.get(v).copied().unwrap_or(1.0) <= 1.0 + 1e-9;
     let l = ctx.plan.l_tar;
     let all = edge_conformity_where(mesh, &metrics, l, |_| true);
     let unbound = edge_conformity_where(mesh, &metrics, l, |e| free(e.0) && free(e.1));
@@ -233,7 +231,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
         },
     );
     let metrics = state.vertex_metrics(ctx);
-    let seams = seam_quality(&state.work, &state.face_patch, &metrics);
+    let seams = seam_quality(&state.work, state.face_patch.as_slice(), &metrics);
     let regions = regions_report(&state, &metrics);
     let sizes = sizes_on_target(ctx, &state);
     let out_topo = Topology::build(&state.work.mesh);
@@ -282,7 +280,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
     RemeshResult {
         mesh: state.work.mesh,
         locations: state.work.locations,
-        face_patch: state.face_patch,
+        face_patch: state.face_patch.into_vec(),
         curve: state.work.curve,
         curves: ctx.curves.clone(),
         report,

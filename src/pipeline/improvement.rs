@@ -46,7 +46,7 @@ impl ImproveRun for Host<'_> {
             embedded_input: ctx.embedded_input,
             tol: passes_tolerance(ctx.plan.eps),
             feature_edges: (!state.features.edges.is_empty()).then_some(&state.features.edges),
-            pinned: &state.pinned,
+            pinned: state.pinned.as_slice(),
             curves: Some(&ctx.curves),
             slide_boundary: o.boundary.resample,
             scope: state.scope.as_deref(),

@@ -22,7 +22,7 @@
 use super::context::{FrozenCut, LoopState, RunContext};
 use super::error::PipelineError;
 use crate::features::FeatureLines;
-use crate::ids::{EdgeKey, FaceId, PatchId, VertexId};
+use crate::ids::{EdgeKey, FaceId, FaceMap, PatchId, VertexId, VertexMap};
 use crate::invariants::{self, TopologySignature};
 use crate::mesh::{Topology, TriMesh, UnionFind};
 use crate::stitch::WorkingMesh;
@@ -226,7 +226,7 @@ pub fn extract(
             triangles,
         },
         locations: whole_of.iter().map(|v| whole.locations[v.idx()]).collect(),
-        processed: faces.iter().map(|f| whole.processed[f.idx()]).collect(),
+        processed: faces.iter().map(|&f| whole.processed[f]).collect(),
         curve: whole_of
             .iter()
             .map(|v| whole.curve.get(v.idx()).copied().flatten())
@@ -324,13 +324,13 @@ pub fn run_regions(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<usize,
     let strip_faces: Vec<bool> = band.iter().zip(&disc).map(|(b, d)| *b && !d).collect();
     let strips = components(mesh, &state.topo, &strip_faces);
     // (Faces a level leaves out stay unprocessed, for the next level or the loop after.)
-    mark_unprocessed(&mut state.work.processed, &strip_faces);
+    mark_unprocessed(state.work.processed.as_mut_slice(), &strip_faces);
     let mut frozen = run_groups(ctx, state, &strips, Level::Strips)?;
     // The junctions, with the strips' ends (their cuts there were frozen).
     let mesh = &state.work.mesh;
     let disc = faces_near(mesh, &junctions, JUNCTION_RINGS + BAND_RINGS, 1);
     let discs = components(mesh, &state.topo, &disc);
-    mark_unprocessed(&mut state.work.processed, &disc);
+    mark_unprocessed(state.work.processed.as_mut_slice(), &disc);
     frozen.extend(run_groups(ctx, state, &discs, Level::Junctions)?);
     // What the strips and junctions kept frozen is where the improvers run once more (their
     // vertices were pinned in every piece); the loop after takes any face still unprocessed.
@@ -625,8 +625,8 @@ fn run_region(
         frozen: Some(cut.clone()),
     };
     let features = region_features(&whole.features, &region);
-    let pinned = from_whole(&whole.pinned);
-    let bound = region.whole.iter().map(|v| whole.bound[v.idx()]).collect();
+    let pinned = VertexMap::from_vec(from_whole(whole.pinned.as_slice()));
+    let bound = region.whole.iter().map(|&v| whole.bound[v]).collect();
     let mut state = LoopState::from_parts(region.work.clone(), topo, features, pinned, bound);
     state.budget_share = share;
     // The further sweeps (the coarse-input profile) are the first level's; the strips and
@@ -683,13 +683,13 @@ fn region_features(whole: &FeatureLines, region: &RegionMesh) -> FeatureLines {
 fn merge(state: &mut LoopState, region_of: &[u32], runs: Vec<RegionRun>) -> Vec<Vec<VertexId>> {
     let w = &mut state.work;
     let mut triangles = Vec::with_capacity(w.mesh.n_faces());
-    let mut processed = Vec::with_capacity(w.mesh.n_faces());
-    let mut face_patch = Vec::with_capacity(w.mesh.n_faces());
+    let mut processed = FaceMap::from_vec(Vec::with_capacity(w.mesh.n_faces()));
+    let mut face_patch = FaceMap::from_vec(Vec::with_capacity(w.mesh.n_faces()));
     for (f, t) in w.mesh.triangles.iter().enumerate() {
         if region_of[f] == u32::MAX {
             triangles.push(*t);
-            processed.push(w.processed[f]);
-            face_patch.push(state.face_patch.get(f).copied().flatten());
+            processed.push(w.processed[FaceId::new(f)]);
+            face_patch.push(state.face_patch.get(FaceId::new(f)).copied().flatten());
         }
     }
     let mut cuts = Vec::with_capacity(runs.len());
@@ -702,7 +702,9 @@ fn merge(state: &mut LoopState, region_of: &[u32], runs: Vec<RegionRun>) -> Vec<
             w.mesh.positions.push(rs.work.mesh.positions[l]);
             w.locations.push(rs.work.locations[l]);
             w.curve.push(rs.work.curve.get(l).copied().flatten());
-            state.bound.push(rs.bound.get(l).copied().unwrap_or(1.0));
+            state
+                .bound
+                .push(rs.bound.get(VertexId::new(l)).copied().unwrap_or(1.0));
             state.pinned.push(false);
             state.factors.push(rs.factors.get(VertexId::new(l)));
         }
@@ -918,8 +920,8 @@ mod tests {
             WorkingMesh::from_reference(&mesh),
             topo.clone(),
             crate::features::FeatureLines::default(),
-            vec![false; n],
-            vec![1.0; n],
+            VertexMap::filled(n, false),
+            VertexMap::filled(n, 1.0),
         );
         // Region 0 is the left half; the right half is in no region and stays as it is.
         let region_of: Vec<u32> = (mesh.faces())
@@ -938,8 +940,8 @@ mod tests {
             region.work.clone(),
             Topology::build(&region.work.mesh),
             crate::features::FeatureLines::default(),
-            vec![false; nl],
-            vec![1.0; nl],
+            VertexMap::filled(nl, false),
+            VertexMap::filled(nl, 1.0),
         );
         let inner = (0..nl)
             .find(|&l| {

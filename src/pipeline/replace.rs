@@ -43,7 +43,7 @@ pub fn replace_batch(
         records,
     } = number_patches(state, outcomes, &crossing, &deferred);
     for f in &kept_faces {
-        state.work.processed[f.idx()] = true;
+        state.work.processed[*f] = true;
     }
     let t0 = Instant::now();
     // Vertices of the faces the patches remove (their boundaries and interiors): with the
@@ -58,8 +58,10 @@ pub fn replace_batch(
     state.counters.times.stitch += t0.elapsed().as_secs_f64();
     let gone: Vec<FaceId> = remeshed.iter().flat_map(|r| r.1.iter().copied()).collect();
     follow_stitched(ctx, state, remeshed, &gone, &new_faces)?;
-    debug_assert_eq!(state.bound.len(), state.work.mesh.n_vertices());
-    debug_assert_eq!(state.face_patch.len(), state.work.mesh.n_faces());
+    debug_assert!(
+        state.in_step(),
+        "the per-element state follows the working mesh"
+    );
     // The stitched faces join the face index (the kept ones are listed already).
     if let Some(near) = &mut state.near {
         near.insert(&state.work.mesh, new_faces.iter().flatten().copied());
@@ -219,9 +221,11 @@ fn stitch_batch(
     })
 }
 
-/// The per-vertex and per-face state follows the stitched patches: the `removed` faces'
-/// provenance goes, each new vertex gets its a-priori fidelity bound and factor, each new
-/// face its patch.
+/// The loop's per-vertex and per-face state follows the stitched patches, the one place it
+/// does ([`stitch_all`] updates the working mesh's own): the `removed` faces' entries go, the
+/// others keep their order; each new vertex gets its a-priori fidelity bound and factor, each
+/// new face its patch. A new per-element field of [`LoopState`] follows here, and joins
+/// [`LoopState::in_step`].
 fn follow_stitched(
     ctx: &RunContext<'_>,
     state: &mut LoopState,
@@ -229,7 +233,11 @@ fn follow_stitched(
     removed: &[FaceId],
     new_faces: &[Vec<FaceId>],
 ) -> Result<(), PipelineError> {
-    drop_provenance(&mut state.face_patch, removed);
+    let mut gone = vec![false; state.face_patch.len()];
+    for f in removed {
+        gone[f.idx()] = true;
+    }
+    state.face_patch.drop_marked(&gone);
     let reference = ctx.quality_field.reference();
     let mut n = state.work.mesh.n_vertices()
         - remeshed
@@ -243,6 +251,9 @@ fn follow_stitched(
             state
                 .bound
                 .push(a_priori_at(&ctx.plan.fid_scale, reference, loc) * rounds);
+            // New vertices are not pinned: corners and feature-line vertices are never
+            // inside a patch.
+            state.pinned.push(false);
         }
         state
             .factors
@@ -256,20 +267,6 @@ fn follow_stitched(
         state.face_patch.extend(faces.iter().map(|_| Some(pid)));
     }
     Ok(())
-}
-
-/// `stitch_all` drops the patches' faces in order and appends the new ones: the provenance of
-/// the remaining faces follows (the new faces' is appended by the caller).
-fn drop_provenance(face_patch: &mut Vec<Option<PatchId>>, removed: &[FaceId]) {
-    let mut gone = vec![false; face_patch.len()];
-    for f in removed {
-        gone[f.idx()] = true;
-    }
-    let mut k = 0;
-    face_patch.retain(|_| {
-        k += 1;
-        !gone[k - 1]
-    });
 }
 
 /// What a stitched batch changed, for its certificates.

@@ -130,10 +130,7 @@ pub fn patch_step(
     let mut log = StepLog::default();
     let mut faces = patch.faces.clone();
     let mut outcome = loop {
-        let unprocessed_in = faces
-            .iter()
-            .filter(|f| !state.work.processed[f.idx()])
-            .count();
+        let unprocessed_in = faces.iter().filter(|&&f| !state.work.processed[f]).count();
         if unprocessed_in == 0 {
             return Err(PipelineError::NoProgress { patch: pid, seed });
         }
