@@ -21,7 +21,7 @@ pub mod snapshot;
 pub mod stats;
 
 pub use config::{Config, Input};
-pub use grid::{Grid, Job, RunRecord, Status};
+pub use grid::{Grid, Job, PictureError, RunRecord, Status};
 pub use snapshot::{Drift, Snapshot};
 
 use measures::MEASURES;
