@@ -405,7 +405,7 @@ fn read_result(dir: &Path, files: &RunFiles) -> Result<(String, RunResult), supe
     let json: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| super::CompareError::Report {
             path: report.display().to_string(),
-            detail: e.to_string(),
+            defect: super::ReportDefect::NotJson(e),
         })?;
     let result = RunResult::from_report(&json, &files.report)?;
     Ok((sha, result))
