@@ -179,7 +179,8 @@ fn better_at_the_bottom(old: &[TriangleQuality], new: &[TriangleQuality]) -> boo
         a
     };
     let (a_old, a_new) = (angles(old), angles(new));
-    if new.len() != old.len() || new.is_empty() || q_min(new) < q_min(old) || a_new[0] < a_old[0] {
+    // Fewer faces: the planar updates' edge collapses; never more.
+    if new.len() > old.len() || new.is_empty() || q_min(new) < q_min(old) || a_new[0] < a_old[0] {
         return false;
     }
     a_new

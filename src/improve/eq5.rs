@@ -57,6 +57,12 @@ pub struct Eq5Options {
     pub flip_rule: FlipRule,
     /// The equilateral triangle of Eq. 5 (default [`Target::OwnArea`], paper-notes.md Sec. 3.4).
     pub target: Target,
+    /// Edge collapses after each connectivity update: a triangle whose smallest metric angle is
+    /// below this (degrees) loses its shortest edge when that raises the smallest angle around
+    /// it (default 0: none; notes/small-angles.md has what 30 does to the shared meshes). A short
+    /// edge makes a small angle that neither flips nor moves can open: the vertices around it
+    /// are too many for the space.
+    pub collapse_below_deg: f64,
 }
 
 impl Default for Eq5Options {
@@ -68,6 +74,7 @@ impl Default for Eq5Options {
             line_search: 30,
             flip_rule: FlipRule::Energy,
             target: Target::OwnArea,
+            collapse_below_deg: 0.0,
         }
     }
 }
@@ -105,6 +112,8 @@ pub struct Eq5Counts {
     pub moves: usize,
     /// Edges flipped.
     pub flips: usize,
+    /// Edges collapsed.
+    pub collapses: usize,
     /// Rounds run (a round that changes nothing ends the updates).
     pub rounds: usize,
 }
@@ -393,6 +402,161 @@ impl State<'_> {
         flips
     }
 
+    /// The smallest angle of a triangle in its mean vertex tensor, degrees.
+    fn min_angle(&self, t: [u32; 3]) -> f64 {
+        let m = (self.tensors[t[0] as usize]
+            + self.tensors[t[1] as usize]
+            + self.tensors[t[2] as usize])
+            / 3.0;
+        let (l, _) =
+            crate::remesh2d::stats::sides_and_quality(&t.map(|v| self.pts[v as usize]), &m);
+        smallest_angle_deg(l)
+    }
+
+    /// The live triangles around `v`.
+    fn live_star<'s>(&'s self, v: u32, dead: &'s [bool]) -> impl Iterator<Item = u32> + 's {
+        self.star[v as usize]
+            .iter()
+            .copied()
+            .filter(move |&t| !dead[t as usize])
+    }
+
+    /// Collapse vertex `from` into `to` along the edge between them, if that is a valid
+    /// collapse: `from` is free, the edge is not locked, the two vertices share exactly the two
+    /// opposite vertices (the link condition: the result is a triangulation of the same disk),
+    /// and every triangle that keeps `from`'s place is positive (exact). Returns the smallest
+    /// angle of the triangles around `to` afterwards, and those triangles.
+    fn collapse_result(&self, from: u32, to: u32, dead: &[bool]) -> Option<(f64, Vec<[u32; 3]>)> {
+        if self.fixed[from as usize] || self.locked.contains(&(from.min(to), from.max(to))) {
+            return None;
+        }
+        let ring = |v: u32| -> std::collections::BTreeSet<u32> {
+            self.live_star(v, dead)
+                .flat_map(|t| self.tris[t as usize])
+                .filter(|&u| u != v)
+                .collect()
+        };
+        let (rf, rt) = (ring(from), ring(to));
+        let shared = self
+            .live_star(from, dead)
+            .filter(|&t| self.tris[t as usize].contains(&to))
+            .count();
+        if shared != 2 || rf.intersection(&rt).count() != 2 {
+            return None;
+        }
+        // The new edges are no longer than the longest edge around the pair now, nor than the
+        // lengths Algorithm 1 makes (1.4 L_tar in the metric): where the fidelity control made
+        // the mesh finer than the metric asks, a longer edge would cut across the surface.
+        let len = |u: u32, v: u32| {
+            let e = self.pts[u as usize] - self.pts[v as usize];
+            let m = (self.tensors[u as usize] + self.tensors[v as usize]) / 2.0;
+            e.dot(&(m * e)).max(0.0).sqrt()
+        };
+        let longest = self
+            .live_star(from, dead)
+            .chain(self.live_star(to, dead))
+            .flat_map(|t| {
+                let t = self.tris[t as usize];
+                [len(t[0], t[1]), len(t[1], t[2]), len(t[2], t[0])]
+            })
+            .fold(0.0, f64::max)
+            .min(MAX_COLLAPSED_EDGE * self.l_tar);
+        if rf.iter().any(|&u| u != to && len(u, to) > longest) {
+            return None;
+        }
+        let mut after = Vec::new();
+        for t in self.live_star(from, dead) {
+            let tri = self.tris[t as usize];
+            if tri.contains(&to) {
+                continue;
+            }
+            let moved = tri.map(|u| if u == from { to } else { u });
+            if !self.positive(moved, None) {
+                return None;
+            }
+            after.push(moved);
+        }
+        after.extend(
+            self.live_star(to, dead)
+                .map(|t| self.tris[t as usize])
+                .filter(|tri| !tri.contains(&from)),
+        );
+        let worst = after
+            .iter()
+            .map(|&t| self.min_angle(t))
+            .fold(f64::INFINITY, f64::min);
+        Some((worst, after))
+    }
+
+    /// One sweep of edge collapses: each triangle (in id order) whose smallest metric angle is
+    /// below `below_deg` loses its shortest edge, into whichever end gives the larger smallest
+    /// angle, when that angle beats the one before around both ends. The triangles touched wait
+    /// for the next sweep; collapsed vertices are left without triangles (dropped at the end).
+    fn collapse_pass(&mut self, below_deg: f64) -> usize {
+        let mut dead = vec![false; self.tris.len()];
+        let mut touched = vec![false; self.pts.len()];
+        let mut collapses = 0;
+        for t in 0..self.tris.len() {
+            let tri = self.tris[t];
+            if dead[t] || tri.iter().any(|&v| touched[v as usize]) {
+                continue;
+            }
+            let m = (self.tensors[tri[0] as usize]
+                + self.tensors[tri[1] as usize]
+                + self.tensors[tri[2] as usize])
+                / 3.0;
+            let (l, _) =
+                crate::remesh2d::stats::sides_and_quality(&tri.map(|v| self.pts[v as usize]), &m);
+            if smallest_angle_deg(l) >= below_deg {
+                continue;
+            }
+            // The shortest side is opposite the smallest angle: side k joins corners k+1, k+2.
+            let k = (0..3).min_by(|&i, &j| l[i].total_cmp(&l[j])).unwrap_or(0);
+            let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            let before = self
+                .live_star(a, &dead)
+                .chain(self.live_star(b, &dead))
+                .map(|t| self.min_angle(self.tris[t as usize]))
+                .fold(f64::INFINITY, f64::min);
+            let best = [(b, a), (a, b)]
+                .into_iter()
+                .filter_map(|(from, to)| {
+                    self.collapse_result(from, to, &dead)
+                        .map(|(worst, _)| (worst, from, to))
+                })
+                .max_by(|x, y| x.0.total_cmp(&y.0));
+            let Some((worst, from, to)) = best else {
+                continue;
+            };
+            if worst <= before {
+                continue;
+            }
+            let star_from: Vec<u32> = self.live_star(from, &dead).collect();
+            let star_to: Vec<u32> = self.live_star(to, &dead).collect();
+            for &s in star_from.iter().chain(&star_to) {
+                for v in self.tris[s as usize] {
+                    touched[v as usize] = true;
+                }
+            }
+            for s in star_from {
+                let tri = &mut self.tris[s as usize];
+                if tri.contains(&to) {
+                    dead[s as usize] = true;
+                } else {
+                    *tri = tri.map(|u| if u == from { to } else { u });
+                }
+            }
+            self.moved[from as usize] = true;
+            collapses += 1;
+        }
+        if collapses > 0 {
+            let mut keep = dead.iter().map(|d| !d);
+            self.tris.retain(|_| keep.next().unwrap_or(true));
+            self.rebuild_stars();
+        }
+        collapses
+    }
+
     fn rebuild_stars(&mut self) {
         self.star = vec![Vec::new(); self.pts.len()];
         for (i, t) in self.tris.iter().enumerate() {
@@ -401,6 +565,21 @@ impl State<'_> {
             }
         }
     }
+}
+
+/// The longest metric edge, over `L_tar`, an edge collapse may make: the upper end of the
+/// lengths Algorithm 1 aims at (paper-notes.md Sec. 3.4).
+const MAX_COLLAPSED_EDGE: f64 = 1.4;
+
+/// The smallest angle (degrees) of a triangle with sides `l`, by the law of cosines.
+fn smallest_angle_deg(l: [f64; 3]) -> f64 {
+    (0..3)
+        .map(|i| {
+            let (a, b, c) = (l[i], l[(i + 1) % 3], l[(i + 2) % 3]);
+            let cs = ((b * b + c * c - a * a) / (2.0 * b * c)).clamp(-1.0, 1.0);
+            cs.acos().to_degrees()
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// `t` is the triangle `(a, b, c)`, in some rotation.
@@ -474,17 +653,32 @@ pub fn improve_planar(
         let flips = s.flip_pass(options.flip_rule);
         counts.flips += flips;
         changed += flips;
+        if options.collapse_below_deg > 0.0 {
+            let collapses = s.collapse_pass(options.collapse_below_deg);
+            counts.collapses += collapses;
+            changed += collapses;
+        }
         if changed == 0 {
             break;
         }
     }
-    let origin = (0..n as u32)
-        .map(|v| (!s.moved[v as usize]).then_some(v))
-        .collect();
+    // Collapsed vertices have no triangles left; only free vertices collapse, so every
+    // boundary and constrained vertex stays.
+    let mut new_id = vec![u32::MAX; n];
+    let (mut points, mut origin) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for v in 0..n {
+        if s.star[v].is_empty() && !s.fixed[v] && counts.collapses > 0 {
+            continue;
+        }
+        new_id[v] = points.len() as u32;
+        points.push(s.pts[v]);
+        origin.push((!s.moved[v]).then_some(v as u32));
+    }
+    let triangles = s.tris.iter().map(|t| t.map(|v| new_id[v as usize])).collect();
     Ok((
         PlanarMesh {
-            points: s.pts,
-            triangles: s.tris,
+            points,
+            triangles,
             origin,
         },
         counts,
@@ -582,6 +776,53 @@ mod tests {
             boundary: vec![0, 1, 2, 3],
             constrained_edges: Vec::new(),
         }
+    }
+
+    /// An obtuse triangle split at an inner vertex: whatever its position, one of the parts
+    /// has an angle of at most half the base angle (19.3°); the triangle itself has 38.7°.
+    fn split_triangle() -> PlanarDomain {
+        PlanarDomain {
+            points: vec![
+                Point2::new(0.0, 0.0),
+                Point2::new(2.0, 0.0),
+                Point2::new(1.0, 0.8),
+                Point2::new(1.0, 0.3),
+            ],
+            triangles: vec![[0, 1, 3], [1, 2, 3], [2, 0, 3]],
+            boundary: vec![0, 1, 2],
+            constrained_edges: Vec::new(),
+        }
+    }
+
+    fn smallest_angle(m: &PlanarMesh) -> f64 {
+        m.triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|v| m.points[v as usize]);
+                let (l, _) = crate::remesh2d::stats::sides_and_quality(&p, &Matrix2::identity());
+                smallest_angle_deg(l)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn an_inner_vertex_no_move_can_place_well_is_collapsed() -> Result<(), Remesh2dError> {
+        let dom = split_triangle();
+        let (kept, counts) = improve_planar(&dom, &Iso, 2.0, &Eq5Options::default())?;
+        assert_eq!((counts.collapses, kept.triangles.len()), (0, 3), "off by default");
+        let on = Eq5Options {
+            collapse_below_deg: 30.0,
+            ..Eq5Options::default()
+        };
+        let (out, counts) = improve_planar(&dom, &Iso, 2.0, &on)?;
+        certify_planar(&dom, &out).expect("certified");
+        assert_eq!(counts.collapses, 1, "{counts:?}");
+        assert_eq!(out.triangles.len(), 1);
+        assert_eq!(out.points, dom.points[..3], "boundary kept bit for bit, inner vertex gone");
+        assert_eq!(out.origin, vec![Some(0), Some(1), Some(2)]);
+        let (before, after) = (smallest_angle(&kept), smallest_angle(&out));
+        assert!(before < 19.4 && (after - 38.66).abs() < 0.01, "{before}° → {after}°");
+        Ok(())
     }
 
     #[test]

@@ -40,6 +40,7 @@ mod registry;
 pub use algorithm2::{Algorithm2, ImproveOptions};
 pub use eq5::{Eq5Options, Eq5Updates, FlipRule, Target};
 pub use flips::connectivity_update;
+pub(crate) use geometry::point_triangle_distance;
 pub use registry::{improver, IMPROVERS};
 pub use relocate::vertex_position_update;
 

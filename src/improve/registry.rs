@@ -95,6 +95,11 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
                 doc: "halvings of a step's line search",
                 default: |_| ImproveOptions::default().planar.line_search.to_string(),
             },
+            OptionDoc {
+                name: "collapse",
+                doc: "collapse the shortest edge of a triangle whose smallest angle is below this (degrees, [0, 60); 0: none) when that raises the smallest angle around it",
+                default: |_| ImproveOptions::default().planar.collapse_below_deg.to_string(),
+            },
         ],
         build: eq5,
     },
@@ -176,6 +181,11 @@ fn eq5(p: &mut Params, _: MetricSizes) -> Result<Box<dyn Improver>, BadValue> {
     }
     if let Some(n) = p.take("line_search", "a number of halvings")? {
         o.planar.line_search = n;
+    }
+    if let Some(a) = p.take_checked("collapse", "an angle in [0, 60) degrees", |a: f64| {
+        (0.0..60.0).contains(&a)
+    })? {
+        o.planar.collapse_below_deg = a;
     }
     Ok(Box::new(Algorithm2 { options: o }))
 }

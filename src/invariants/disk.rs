@@ -22,6 +22,28 @@ fn not_disk(defect: DiskDefect) -> InvariantError {
 /// Errors are [`InvariantError::NotADisk`] whose [`DiskDefect`] names the offending face,
 /// edge, vertex or count.
 pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, InvariantError> {
+    let sorted = distinct_faces(mesh, faces)?;
+    let (edges, keys) = manifold_edges(mesh, &sorted)?;
+    let verts = single_fans(mesh, &sorted, &edges)?;
+    connected(&sorted, &edges, &keys)?;
+    let boundary = one_boundary_loop(&sorted, &edges, &keys)?;
+    let chi = verts.len() as i64 - keys.len() as i64 + sorted.len() as i64;
+    if chi != 1 {
+        return Err(not_disk(DiskDefect::euler(
+            verts.len(),
+            keys.len(),
+            sorted.len(),
+        )));
+    }
+    Ok(boundary)
+}
+
+/// The patch's directed edges grouped by undirected edge: (from, to, index in the sorted
+/// faces).
+type PatchEdges = HashMap<EdgeKey, Vec<(VertexId, VertexId, usize)>>;
+
+/// The faces sorted, each listed once and existing.
+fn distinct_faces(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<FaceId>, InvariantError> {
     if faces.is_empty() {
         return Err(not_disk(DiskDefect::NoFaces));
     }
@@ -38,8 +60,17 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
             faces: mesh.n_faces(),
         }));
     }
+    Ok(sorted)
+}
+
+/// The patch's edges (and their keys, sorted), each with at most two faces traversing it in
+/// opposite directions (edge-manifold, oriented).
+fn manifold_edges(
+    mesh: &TriMesh,
+    sorted: &[FaceId],
+) -> Result<(PatchEdges, Vec<EdgeKey>), InvariantError> {
     // Directed edges of the patch, grouped by undirected edge: (from, to, local face index).
-    let mut edges: HashMap<EdgeKey, Vec<(VertexId, VertexId, usize)>> = HashMap::new();
+    let mut edges: PatchEdges = HashMap::new();
     for (k, &f) in sorted.iter().enumerate() {
         let t = mesh.face(f);
         for i in 0..3 {
@@ -64,6 +95,15 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
             }));
         }
     }
+    Ok((edges, keys))
+}
+
+/// The patch's vertices, sorted, each one's patch faces forming one fan.
+fn single_fans(
+    mesh: &TriMesh,
+    sorted: &[FaceId],
+    edges: &PatchEdges,
+) -> Result<Vec<VertexId>, InvariantError> {
     // Vertex-manifold: the patch faces around each vertex form one fan, i.e. are connected
     // through patch edges at that vertex.
     let mut vertex_faces: HashMap<VertexId, Vec<usize>> = HashMap::new();
@@ -105,9 +145,18 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
             }));
         }
     }
+    Ok(verts)
+}
+
+/// The patch faces are connected through edges.
+fn connected(
+    sorted: &[FaceId],
+    edges: &PatchEdges,
+    keys: &[EdgeKey],
+) -> Result<(), InvariantError> {
     // Connected through edges.
     let mut sets = UnionFind::new(sorted.len());
-    for key in &keys {
+    for key in keys {
         let hs = &edges[key];
         if hs.len() == 2 {
             sets.union(hs[0].2, hs[1].2);
@@ -119,9 +168,19 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
             faces: Some((sorted[0], sorted[k])),
         }));
     }
+    Ok(())
+}
+
+/// The one boundary loop, from the smallest vertex id, following the boundary half-edges
+/// (one outgoing per vertex: the patch is vertex-manifold).
+fn one_boundary_loop(
+    sorted: &[FaceId],
+    edges: &PatchEdges,
+    keys: &[EdgeKey],
+) -> Result<Vec<VertexId>, InvariantError> {
     // Boundary loops: boundary half-edges, one outgoing per vertex (vertex-manifold).
     let mut next: HashMap<VertexId, VertexId> = HashMap::new();
-    for key in &keys {
+    for key in keys {
         let hs = &edges[key];
         if hs.len() == 1 {
             next.insert(hs[0].0, hs[0].1);
@@ -164,14 +223,6 @@ pub fn certify_disk(mesh: &TriMesh, faces: &[FaceId]) -> Result<Vec<VertexId>, I
             loops: loops.len(),
             starts: Offenders(loops.iter().map(|l| l[0]).collect()),
         }));
-    }
-    let chi = verts.len() as i64 - keys.len() as i64 + sorted.len() as i64;
-    if chi != 1 {
-        return Err(not_disk(DiskDefect::euler(
-            verts.len(),
-            keys.len(),
-            sorted.len(),
-        )));
     }
     Ok(loops.pop().unwrap_or_default())
 }

@@ -153,6 +153,24 @@ impl<'a> PolygonSlabs<'a> {
 /// (2) and (4) together already imply an exact tiling of the polygon: a positively oriented
 /// 2-chain whose boundary is a simple loop covers its inside exactly once.
 pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), InvariantError> {
+    let np = points_and_orientation(out)?;
+    let image = kept_vertices(domain, out)?;
+    let he = half_edges(out)?;
+    let (expected, n_boundary) = boundary_loop_kept(domain, &image, &he)?;
+    constrained_edges_kept(domain, &image, &he)?;
+    euler_disk(out, np, he.len() + n_boundary)?;
+    let poly: Vec<Point2<f64>> = domain
+        .boundary
+        .iter()
+        .map(|&b| domain.points[b as usize])
+        .collect();
+    area_kept(&poly, out)?;
+    interior_inside(&poly, out, &expected)
+}
+
+/// Checks (1) and (2): `origin` one entry per point, coordinates finite, indices in range,
+/// every triangle positive. The number of points.
+fn points_and_orientation(out: &PlanarMesh) -> Result<usize, InvariantError> {
     let np = out.points.len();
     if out.origin.len() != np {
         return Err(invalid(format!(
@@ -189,6 +207,15 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
     if !bad.is_empty() {
         return Err(invalid(format!("non-positive triangles: {}", list(&bad))));
     }
+    Ok(np)
+}
+
+/// Check (3): every kept vertex at its bit-identical input position, once. Input vertex →
+/// output vertex.
+fn kept_vertices(
+    domain: &PlanarDomain,
+    out: &PlanarMesh,
+) -> Result<HashMap<u32, u32>, InvariantError> {
     // (3) kept vertices.
     let mut image: HashMap<u32, u32> = HashMap::new();
     for (i, o) in out.origin.iter().enumerate() {
@@ -222,7 +249,11 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
             list(&missing)
         )));
     }
-    // (4) edges.
+    Ok(image)
+}
+
+/// Check (4), first half: every directed half-edge once. Half-edge → its face.
+fn half_edges(out: &PlanarMesh) -> Result<HashMap<(u32, u32), u32>, InvariantError> {
     let mut he: HashMap<(u32, u32), u32> = HashMap::with_capacity(out.triangles.len() * 3);
     for (f, t) in out.triangles.iter().enumerate() {
         for k in 0..3 {
@@ -234,6 +265,16 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
             }
         }
     }
+    Ok(he)
+}
+
+/// Check (4), second half: the output's boundary half-edges are exactly the images of the
+/// domain's loop. Those images in loop order, and the number of boundary half-edges.
+fn boundary_loop_kept(
+    domain: &PlanarDomain,
+    image: &HashMap<u32, u32>,
+    he: &HashMap<(u32, u32), u32>,
+) -> Result<(Vec<(u32, u32)>, usize), InvariantError> {
     let boundary_he: Vec<(u32, u32)> = he
         .keys()
         .filter(|(a, b)| !he.contains_key(&(*b, *a)))
@@ -267,7 +308,15 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
             list(&names)
         )));
     }
-    // (5) constrained edges.
+    Ok((expected, boundary_he.len()))
+}
+
+/// Check (5): every constrained edge is an edge of the output.
+fn constrained_edges_kept(
+    domain: &PlanarDomain,
+    image: &HashMap<u32, u32>,
+    he: &HashMap<(u32, u32), u32>,
+) -> Result<(), InvariantError> {
     for &[a, b] in &domain.constrained_edges {
         let (ia, ib) = (image[&a], image[&b]);
         if !he.contains_key(&(ia, ib)) && !he.contains_key(&(ib, ia)) {
@@ -276,6 +325,12 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
             )));
         }
     }
+    Ok(())
+}
+
+/// Check (6): every point used, and `V − E + F = 1`; `half_edges` is the output's half-edges
+/// plus its boundary half-edges once more, so twice its edges.
+fn euler_disk(out: &PlanarMesh, np: usize, half_edges: usize) -> Result<(), InvariantError> {
     // (6) disk: every point used, V − E + F = 1.
     let mut used = vec![false; np];
     for t in &out.triangles {
@@ -286,7 +341,7 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
     if let Some(i) = used.iter().position(|u| !u) {
         return Err(invalid(format!("v{i} is not used by any triangle")));
     }
-    let n_edges = (he.len() + boundary_he.len()) / 2;
+    let n_edges = half_edges / 2;
     let chi = np as i64 - n_edges as i64 + out.triangles.len() as i64;
     if chi != 1 {
         return Err(InvariantError::NotADisk(super::DiskDefect::euler(
@@ -295,13 +350,13 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
             out.triangles.len(),
         )));
     }
+    Ok(())
+}
+
+/// Check (7): the total area equals the polygon's `poly` up to a relative 1e-9.
+fn area_kept(poly: &[Point2<f64>], out: &PlanarMesh) -> Result<(), InvariantError> {
     // (7) area.
-    let poly: Vec<Point2<f64>> = domain
-        .boundary
-        .iter()
-        .map(|&b| domain.points[b as usize])
-        .collect();
-    let a_poly = 0.5 * polygon_area2(&poly);
+    let a_poly = 0.5 * polygon_area2(poly);
     let a_out: f64 = out
         .triangles
         .iter()
@@ -317,9 +372,19 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
             "total area {a_out} differs from the polygon's {a_poly}"
         )));
     }
+    Ok(())
+}
+
+/// Check (8): every vertex off the loop `boundary` lies strictly inside the polygon `poly`.
+fn interior_inside(
+    poly: &[Point2<f64>],
+    out: &PlanarMesh,
+    boundary: &[(u32, u32)],
+) -> Result<(), InvariantError> {
+    let np = out.points.len();
     // (8) interior vertices strictly inside.
-    let on_loop: std::collections::HashSet<u32> = expected.iter().map(|e| e.0).collect();
-    let slabs = PolygonSlabs::new(&poly);
+    let on_loop: std::collections::HashSet<u32> = boundary.iter().map(|e| e.0).collect();
+    let slabs = PolygonSlabs::new(poly);
     let outside: Vec<String> = (0..np as u32)
         .filter(|i| !on_loop.contains(i))
         .filter(|&i| slabs.contains(&out.points[i as usize]) != Some(true))

@@ -81,84 +81,17 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         let Some(key) = t.next() else { continue };
         any = true;
         match key {
-            "v" => {
-                let c: Vec<&str> = t.take(3).collect();
-                if c.len() < 3 {
-                    return Err(IoError::Parse {
-                        path: path.to_string(),
-                        format: F,
-                        line: l,
-                        message: format!("vertex with {} coordinates, 3 needed", c.len()),
-                    });
-                }
-                let p = Point3::new(
-                    float(c[0], l, path, F)?,
-                    float(c[1], l, path, F)?,
-                    float(c[2], l, path, F)?,
-                );
-                if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
-                    return Err(IoError::NonFinite {
-                        path: path.to_string(),
-                        line: l,
-                        vertex: positions.len(),
-                    });
-                }
-                positions.push(p);
-            }
-            "vt" => {
-                let u = float(t.next().unwrap_or("0"), l, path, F)?;
-                let v = float(t.next().unwrap_or("0"), l, path, F)?;
-                if !(u.is_finite() && v.is_finite()) {
-                    return Err(IoError::Parse {
-                        path: path.to_string(),
-                        format: F,
-                        line: l,
-                        message: "non-finite texture coordinate".into(),
-                    });
-                }
-                vts.push(Point2::new(u, v));
-            }
-            "f" => {
-                let f = faces.len();
-                faces.begin(l);
-                for corner in t {
-                    let mut parts = corner.split('/');
-                    let written = int(parts.next().unwrap_or(""), l, path, F)?;
-                    let Some(v) = resolve(written, positions.len()) else {
-                        return Err(IoError::BadIndex {
-                            path: path.to_string(),
-                            line: l,
-                            face: f,
-                            index: written,
-                            n_vertices: positions.len(),
-                        });
-                    };
-                    faces.push(v);
-                    match parts.next().filter(|s| !s.is_empty()) {
-                        Some(vt) => {
-                            let wt = int(vt, l, path, F)?;
-                            // Like vertex indices, a texture index must name a `vt` above it.
-                            let r = resolve(wt, vts.len()).filter(|&r| (r as usize) < vts.len());
-                            match (r, corner_vt.as_mut()) {
-                                (Some(r), Some(c)) => c.push((v as usize, r)),
-                                (None, _) => {
-                                    return Err(IoError::Parse {
-                                        path: path.to_string(),
-                                        format: F,
-                                        line: l,
-                                        message: format!(
-                                        "face {f}: texture index {wt} does not exist ({} defined)",
-                                        vts.len()
-                                    ),
-                                    })
-                                }
-                                _ => {}
-                            }
-                        }
-                        None => corner_vt = None,
-                    }
-                }
-            }
+            "v" => positions.push(vertex_line(t, l, path, positions.len())?),
+            "vt" => vts.push(texture_line(t, l, path)?),
+            "f" => face_line(
+                t,
+                l,
+                path,
+                positions.len(),
+                &vts,
+                &mut faces,
+                &mut corner_vt,
+            )?,
             k if IGNORED.contains(&k) => {}
             k => {
                 let k = short(k);
@@ -185,6 +118,129 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
             "{path}: {polygons} polygon faces cut into triangles"
         ));
     }
+    let attributes = texture_per_vertex(corner_vt, &vts, n_v, path, &mut warnings);
+    Ok(LoadedMesh {
+        mesh,
+        polygons_triangulated: polygons,
+        welded_vertices: 0,
+        warnings,
+        attributes,
+        repeated_index_faces: repeated,
+    })
+}
+
+/// A `v` line's position (its first three values); `n` vertices came before it.
+fn vertex_line(
+    t: std::str::SplitAsciiWhitespace,
+    l: usize,
+    path: &str,
+    n: usize,
+) -> Result<Point3<f64>, IoError> {
+    let c: Vec<&str> = t.take(3).collect();
+    if c.len() < 3 {
+        return Err(IoError::Parse {
+            path: path.to_string(),
+            format: F,
+            line: l,
+            message: format!("vertex with {} coordinates, 3 needed", c.len()),
+        });
+    }
+    let p = Point3::new(
+        float(c[0], l, path, F)?,
+        float(c[1], l, path, F)?,
+        float(c[2], l, path, F)?,
+    );
+    if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+        return Err(IoError::NonFinite {
+            path: path.to_string(),
+            line: l,
+            vertex: n,
+        });
+    }
+    Ok(p)
+}
+
+/// A `vt` line's texture coordinate (missing values read as 0).
+fn texture_line(
+    mut t: std::str::SplitAsciiWhitespace,
+    l: usize,
+    path: &str,
+) -> Result<Point2<f64>, IoError> {
+    let u = float(t.next().unwrap_or("0"), l, path, F)?;
+    let v = float(t.next().unwrap_or("0"), l, path, F)?;
+    if !(u.is_finite() && v.is_finite()) {
+        return Err(IoError::Parse {
+            path: path.to_string(),
+            format: F,
+            line: l,
+            message: "non-finite texture coordinate".into(),
+        });
+    }
+    Ok(Point2::new(u, v))
+}
+
+/// An `f` line's corners into `faces`; their texture indices into `corner_vt` while every
+/// corner so far has one. `n_vertices` vertices and the `vts` came before it.
+fn face_line(
+    t: std::str::SplitAsciiWhitespace,
+    l: usize,
+    path: &str,
+    n_vertices: usize,
+    vts: &[Point2<f64>],
+    faces: &mut RawFaces,
+    corner_vt: &mut Option<Vec<(usize, i64)>>,
+) -> Result<(), IoError> {
+    let f = faces.len();
+    faces.begin(l);
+    for corner in t {
+        let mut parts = corner.split('/');
+        let written = int(parts.next().unwrap_or(""), l, path, F)?;
+        let Some(v) = resolve(written, n_vertices) else {
+            return Err(IoError::BadIndex {
+                path: path.to_string(),
+                line: l,
+                face: f,
+                index: written,
+                n_vertices,
+            });
+        };
+        faces.push(v);
+        match parts.next().filter(|s| !s.is_empty()) {
+            Some(vt) => {
+                let wt = int(vt, l, path, F)?;
+                // Like vertex indices, a texture index must name a `vt` above it.
+                let r = resolve(wt, vts.len()).filter(|&r| (r as usize) < vts.len());
+                match (r, corner_vt.as_mut()) {
+                    (Some(r), Some(c)) => c.push((v as usize, r)),
+                    (None, _) => {
+                        return Err(IoError::Parse {
+                            path: path.to_string(),
+                            format: F,
+                            line: l,
+                            message: format!(
+                                "face {f}: texture index {wt} does not exist ({} defined)",
+                                vts.len()
+                            ),
+                        })
+                    }
+                    _ => {}
+                }
+            }
+            None => *corner_vt = None,
+        }
+    }
+    Ok(())
+}
+
+/// The texture coordinates per vertex, when every corner has one and each vertex has one
+/// (no seams); otherwise none, with a warning.
+fn texture_per_vertex(
+    corner_vt: Option<Vec<(usize, i64)>>,
+    vts: &[Point2<f64>],
+    n_v: usize,
+    path: &str,
+    warnings: &mut Vec<String>,
+) -> MeshAttributes {
     let mut attributes = MeshAttributes::default();
     if let Some(c) = corner_vt.filter(|c| !c.is_empty()) {
         let mut corners = Vec::with_capacity(c.len());
@@ -206,14 +262,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
             ));
         }
     }
-    Ok(LoadedMesh {
-        mesh,
-        polygons_triangulated: polygons,
-        welded_vertices: 0,
-        warnings,
-        attributes,
-        repeated_index_faces: repeated,
-    })
+    attributes
 }
 
 pub(super) fn write(

@@ -17,6 +17,41 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         .enumerate()
         .map(|(i, l)| (i + 1, l.split('#').next().unwrap_or("").trim()))
         .filter(|(_, l)| !l.is_empty());
+    let (nv, nf) = counts(&mut lines, path)?;
+    // Each vertex line needs at least "0 0 0" (5 bytes), each face "3 0 1 2" (7 bytes).
+    check_claim(path, F, "vertices", nv, 5, bytes.len())?;
+    check_claim(path, F, "faces", nf, 7, bytes.len())?;
+    let positions = read_vertices(&mut lines, nv, path)?;
+    let mut faces = RawFaces::with_capacity(nf as usize, 0);
+    for f in 0..nf as usize {
+        read_face(&mut lines, f, nf, &mut faces, path)?;
+    }
+    let mut warnings = Vec::new();
+    if let Some((l, _)) = lines.next() {
+        warnings.push(format!("{path}:{l}: data after the last face ignored"));
+    }
+    let (mesh, polygons, _, repeated) = build_mesh(path, F, positions, &faces)?;
+    if polygons > 0 {
+        warnings.push(format!(
+            "{path}: {polygons} polygon faces cut into triangles"
+        ));
+    }
+    Ok(LoadedMesh {
+        mesh,
+        polygons_triangulated: polygons,
+        welded_vertices: 0,
+        warnings,
+        attributes: Default::default(),
+        repeated_index_faces: repeated,
+    })
+}
+
+/// The header: the magic word (`OFF` with its variant letters) and the counts `V F`, on its
+/// line or the next.
+fn counts<'a>(
+    lines: &mut impl Iterator<Item = (usize, &'a str)>,
+    path: &str,
+) -> Result<(u64, u64), IoError> {
     let Some((_, first)) = lines.next() else {
         return Err(IoError::Empty {
             path: path.to_string(),
@@ -70,9 +105,15 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     }
     let nv = count(rest[0], count_line, path, F)?;
     let nf = count(rest[1], count_line, path, F)?;
-    // Each vertex line needs at least "0 0 0" (5 bytes), each face "3 0 1 2" (7 bytes).
-    check_claim(path, F, "vertices", nv, 5, bytes.len())?;
-    check_claim(path, F, "faces", nf, 7, bytes.len())?;
+    Ok((nv, nf))
+}
+
+/// The `nv` vertex lines: the first three values of each.
+fn read_vertices<'a>(
+    lines: &mut impl Iterator<Item = (usize, &'a str)>,
+    nv: u64,
+    path: &str,
+) -> Result<Vec<Point3<f64>>, IoError> {
     let mut positions = Vec::with_capacity(nv as usize);
     for i in 0..nv as usize {
         let Some((l, s)) = lines.next() else {
@@ -105,77 +146,68 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         }
         positions.push(p);
     }
-    let mut faces = RawFaces::with_capacity(nf as usize, 0);
-    for f in 0..nf as usize {
-        let Some((l, s)) = lines.next() else {
-            return Err(IoError::Truncated {
-                path: path.to_string(),
-                format: F,
-                message: format!("header claims {nf} faces, file ends after {f}"),
-            });
+    Ok(positions)
+}
+
+/// Face `f` of `nf`: its count and indices, into `faces`.
+fn read_face<'a>(
+    lines: &mut impl Iterator<Item = (usize, &'a str)>,
+    f: usize,
+    nf: u64,
+    faces: &mut RawFaces,
+    path: &str,
+) -> Result<(), IoError> {
+    let Some((l, s)) = lines.next() else {
+        return Err(IoError::Truncated {
+            path: path.to_string(),
+            format: F,
+            message: format!("header claims {nf} faces, file ends after {f}"),
+        });
+    };
+    let mut t = s.split_ascii_whitespace();
+    let k = count(t.next().unwrap_or(""), l, path, F)?;
+    faces.begin(l);
+    let mut got = 0u64;
+    for tok in t.by_ref().take(k.min(u32::MAX as u64) as usize) {
+        faces.push(int(tok, l, path, F)?);
+        got += 1;
+    }
+    // OFF is read as a token stream by most readers (libigl's `readOFF` among them), and
+    // some writers break a long face over lines: a face that ends its line short takes
+    // the next lines' indices, as long as each such line holds nothing else.
+    let mut at = l;
+    while got < k {
+        let Some((l2, s2)) = lines.next() else {
+            break;
         };
-        let mut t = s.split_ascii_whitespace();
-        let k = count(t.next().unwrap_or(""), l, path, F)?;
-        faces.begin(l);
-        let mut got = 0u64;
-        for tok in t.by_ref().take(k.min(u32::MAX as u64) as usize) {
-            faces.push(int(tok, l, path, F)?);
-            got += 1;
-        }
-        // OFF is read as a token stream by most readers (libigl's `readOFF` among them), and
-        // some writers break a long face over lines: a face that ends its line short takes
-        // the next lines' indices, as long as each such line holds nothing else.
-        let mut at = l;
-        while got < k {
-            let Some((l2, s2)) = lines.next() else {
-                break;
-            };
-            let toks: Vec<&str> = s2.split_ascii_whitespace().collect();
-            if got + toks.len() as u64 > k {
-                return Err(IoError::Parse {
-                    path: path.to_string(),
-                    format: F,
-                    line: l2,
-                    message: format!(
-                        "face {f} announces {k} vertices; it continues from line {l} on this \
-                         line, which holds more than the rest of its indices"
-                    ),
-                });
-            }
-            for tok in toks {
-                faces.push(int(tok, l2, path, F)?);
-                got += 1;
-            }
-            at = l2;
-        }
-        let l = at;
-        if got < k {
+        let toks: Vec<&str> = s2.split_ascii_whitespace().collect();
+        if got + toks.len() as u64 > k {
             return Err(IoError::Parse {
                 path: path.to_string(),
                 format: F,
-                line: l,
-                message: format!("face {f} announces {k} vertices but lists {got}"),
+                line: l2,
+                message: format!(
+                    "face {f} announces {k} vertices; it continues from line {l} on this \
+                     line, which holds more than the rest of its indices"
+                ),
             });
         }
+        for tok in toks {
+            faces.push(int(tok, l2, path, F)?);
+            got += 1;
+        }
+        at = l2;
     }
-    let mut warnings = Vec::new();
-    if let Some((l, _)) = lines.next() {
-        warnings.push(format!("{path}:{l}: data after the last face ignored"));
+    let l = at;
+    if got < k {
+        return Err(IoError::Parse {
+            path: path.to_string(),
+            format: F,
+            line: l,
+            message: format!("face {f} announces {k} vertices but lists {got}"),
+        });
     }
-    let (mesh, polygons, _, repeated) = build_mesh(path, F, positions, &faces)?;
-    if polygons > 0 {
-        warnings.push(format!(
-            "{path}: {polygons} polygon faces cut into triangles"
-        ));
-    }
-    Ok(LoadedMesh {
-        mesh,
-        polygons_triangulated: polygons,
-        welded_vertices: 0,
-        warnings,
-        attributes: Default::default(),
-        repeated_index_faces: repeated,
-    })
+    Ok(())
 }
 
 pub(super) fn write(w: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> {

@@ -243,6 +243,75 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
         line,
         message,
     };
+    let (lines, body_start, end_line) = header_lines(bytes, path)?;
+    let mut h = Header {
+        warnings: Vec::new(),
+        elements: Vec::new(),
+        format: None,
+        body_start,
+        body_first_line: end_line + 1,
+    };
+    for &(l, text) in lines.iter().skip(1) {
+        let t: Vec<&str> = text.split_ascii_whitespace().collect();
+        match t.first().copied() {
+            None | Some("comment") | Some("obj_info") => {}
+            Some("format") => {
+                h.format = Some(match t.get(1).copied() {
+                    Some("ascii") => (false, false),
+                    Some("binary_little_endian") => (true, false),
+                    Some("binary_big_endian") => (true, true),
+                    other => {
+                        return Err(err(
+                            l,
+                            format!("unknown format `{}`", short(other.unwrap_or(""))),
+                        ))
+                    }
+                });
+            }
+            Some("element") => {
+                if t.len() != 3 {
+                    return Err(err(l, "expected `element NAME COUNT`".into()));
+                }
+                let count = t[2]
+                    .parse::<u64>()
+                    .map_err(|_| err(l, format!("bad element count `{}`", short(t[2]))))?;
+                h.elements.push(Element {
+                    name: t[1].to_string(),
+                    count,
+                    props: Vec::new(),
+                });
+            }
+            Some("property") => {
+                let Some(el) = h.elements.last_mut() else {
+                    return Err(err(l, "property before any element".into()));
+                };
+                let prop = parse_property(&t, l, el, path)?;
+                el.props.push(prop);
+            }
+            // A line that is no keyword (an exporter's free text, `Created by Blender3D 247
+            // ...`) cannot change the data layout, which only `format`, `element` and
+            // `property` lines set: it is skipped, with a warning naming it.
+            Some(k) => h.warnings.push(format!(
+                "{path}:{l}: PLY header line starting with unknown keyword `{}` skipped",
+                short(k)
+            )),
+        }
+    }
+    if h.format.is_none() {
+        return Err(err(2, "no `format` line".into()));
+    }
+    Ok(h)
+}
+
+/// Numbered text lines.
+type HeaderLines<'b> = Vec<(usize, &'b str)>;
+
+/// The header's text lines with their numbers (the magic `ply` first, `end_header` left
+/// out), the body's byte offset and the number of the `end_header` line.
+fn header_lines<'b>(
+    bytes: &'b [u8],
+    path: &str,
+) -> Result<(HeaderLines<'b>, usize, usize), IoError> {
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(IoError::Empty {
             path: path.to_string(),
@@ -290,106 +359,63 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
             if matches!(word, Some(b"comment" | b"obj_info")) {
                 continue;
             }
-            return Err(err(line_no, "header line is not text".into()));
+            return Err(IoError::Parse {
+                path: path.to_string(),
+                format: F,
+                line: line_no,
+                message: "header line is not text".into(),
+            });
         };
         if text.trim() == "end_header" {
             break pos;
         }
         lines.push((line_no, text));
     };
-    let mut h = Header {
-        warnings: Vec::new(),
-        elements: Vec::new(),
-        format: None,
-        body_start,
-        body_first_line: line_no + 1,
+    Ok((lines, body_start, line_no))
+}
+
+/// One `property` line (`t`, split at whitespace; line `l`) of element `el`.
+fn parse_property(t: &[&str], l: usize, el: &Element, path: &str) -> Result<Prop, IoError> {
+    let err = |message: String| IoError::Parse {
+        path: path.to_string(),
+        format: F,
+        line: l,
+        message,
     };
-    for &(l, text) in lines.iter().skip(1) {
-        let t: Vec<&str> = text.split_ascii_whitespace().collect();
-        match t.first().copied() {
-            None | Some("comment") | Some("obj_info") => {}
-            Some("format") => {
-                h.format = Some(match t.get(1).copied() {
-                    Some("ascii") => (false, false),
-                    Some("binary_little_endian") => (true, false),
-                    Some("binary_big_endian") => (true, true),
-                    other => {
-                        return Err(err(
-                            l,
-                            format!("unknown format `{}`", short(other.unwrap_or(""))),
-                        ))
-                    }
-                });
-            }
-            Some("element") => {
-                if t.len() != 3 {
-                    return Err(err(l, "expected `element NAME COUNT`".into()));
-                }
-                let count = t[2]
-                    .parse::<u64>()
-                    .map_err(|_| err(l, format!("bad element count `{}`", short(t[2]))))?;
-                h.elements.push(Element {
-                    name: t[1].to_string(),
-                    count,
-                    props: Vec::new(),
-                });
-            }
-            Some("property") => {
-                let Some(el) = h.elements.last_mut() else {
-                    return Err(err(l, "property before any element".into()));
-                };
-                let unknown = |ty: &str, name: &str| IoError::UnknownProperty {
-                    path: path.to_string(),
-                    line: l,
-                    element: el.name.clone(),
-                    property: name.to_string(),
-                    ty: short(ty),
-                };
-                let prop = if t.get(1) == Some(&"list") {
-                    if t.len() != 5 {
-                        return Err(err(
-                            l,
-                            "expected `property list COUNT_TYPE TYPE NAME`".into(),
-                        ));
-                    }
-                    let ct = Ty::parse(t[2]).ok_or_else(|| unknown(t[2], t[4]))?;
-                    let ty = Ty::parse(t[3]).ok_or_else(|| unknown(t[3], t[4]))?;
-                    if !ct.is_int() {
-                        return Err(err(
-                            l,
-                            format!("list `{}` has non-integer count type `{}`", t[4], t[2]),
-                        ));
-                    }
-                    Prop {
-                        name: t[4].to_string(),
-                        list: Some(ct),
-                        ty,
-                    }
-                } else {
-                    if t.len() != 3 {
-                        return Err(err(l, "expected `property TYPE NAME`".into()));
-                    }
-                    Prop {
-                        name: t[2].to_string(),
-                        list: None,
-                        ty: Ty::parse(t[1]).ok_or_else(|| unknown(t[1], t[2]))?,
-                    }
-                };
-                el.props.push(prop);
-            }
-            // A line that is no keyword (an exporter's free text, `Created by Blender3D 247
-            // ...`) cannot change the data layout, which only `format`, `element` and
-            // `property` lines set: it is skipped, with a warning naming it.
-            Some(k) => h.warnings.push(format!(
-                "{path}:{l}: PLY header line starting with unknown keyword `{}` skipped",
-                short(k)
-            )),
+    let unknown = |ty: &str, name: &str| IoError::UnknownProperty {
+        path: path.to_string(),
+        line: l,
+        element: el.name.clone(),
+        property: name.to_string(),
+        ty: short(ty),
+    };
+    if t.get(1) == Some(&"list") {
+        if t.len() != 5 {
+            return Err(err("expected `property list COUNT_TYPE TYPE NAME`".into()));
         }
+        let ct = Ty::parse(t[2]).ok_or_else(|| unknown(t[2], t[4]))?;
+        let ty = Ty::parse(t[3]).ok_or_else(|| unknown(t[3], t[4]))?;
+        if !ct.is_int() {
+            return Err(err(format!(
+                "list `{}` has non-integer count type `{}`",
+                t[4], t[2]
+            )));
+        }
+        Ok(Prop {
+            name: t[4].to_string(),
+            list: Some(ct),
+            ty,
+        })
+    } else {
+        if t.len() != 3 {
+            return Err(err("expected `property TYPE NAME`".into()));
+        }
+        Ok(Prop {
+            name: t[2].to_string(),
+            list: None,
+            ty: Ty::parse(t[1]).ok_or_else(|| unknown(t[1], t[2]))?,
+        })
     }
-    if h.format.is_none() {
-        return Err(err(2, "no `format` line".into()));
-    }
-    Ok(h)
 }
 
 /// Per-element roles of the properties the reader keeps.
@@ -399,35 +425,29 @@ struct FaceRoles {
     rgb: Option<[usize; 3]>,
 }
 
+/// What the body's elements hold, as read so far.
+struct Contents {
+    positions: Vec<Point3<f64>>,
+    uv: Option<Vec<Point2<f64>>>,
+    faces: RawFaces,
+    /// Integer face properties by name (one value per face).
+    face_ints: Vec<(String, Vec<i64>)>,
+    colors: Option<Vec<[u8; 3]>>,
+    saw_vertex: bool,
+    saw_faces: bool,
+}
+
+/// The scratch buffers one element is read into, reused across elements.
+struct Scratch {
+    vals: Vec<Num>,
+    list: Vec<i64>,
+}
+
 pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let mut h = parse_header(bytes, path)?;
     let (binary, big_endian) = h.format.unwrap_or((false, false));
     let body_bytes = &bytes[h.body_start..];
-    let body = if binary {
-        Body::Binary {
-            data: body_bytes,
-            pos: 0,
-            big_endian,
-        }
-    } else {
-        Body::Ascii(Tokens::starting_at(
-            as_text(body_bytes, path, F).map_err(|e| match e {
-                IoError::Parse {
-                    path,
-                    format,
-                    line,
-                    message,
-                } => IoError::Parse {
-                    path,
-                    format,
-                    line: line + h.body_first_line - 1,
-                    message,
-                },
-                e => e,
-            })?,
-            h.body_first_line,
-        ))
-    };
+    let body = body(body_bytes, binary, big_endian, h.body_first_line, path)?;
     for el in &h.elements {
         // +1: the last ASCII token needs no separator after it.
         check_claim(
@@ -439,166 +459,261 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
             body_bytes.len() + 1,
         )?;
     }
-    let parse_err = |message: String| IoError::Parse {
-        path: path.to_string(),
-        format: F,
-        line: 0,
-        message,
-    };
     let mut rd = Reader { body, path };
-    let mut positions: Vec<Point3<f64>> = Vec::new();
-    let mut uv: Option<Vec<Point2<f64>>> = None;
-    let mut faces = RawFaces::with_capacity(0, 0);
-    let mut face_ints: Vec<(String, Vec<i64>)> = Vec::new();
-    let mut colors: Option<Vec<[u8; 3]>> = None;
-    let mut saw_vertex = false;
-    let mut saw_faces = false;
+    let mut c = Contents {
+        positions: Vec::new(),
+        uv: None,
+        faces: RawFaces::with_capacity(0, 0),
+        face_ints: Vec::new(),
+        colors: None,
+        saw_vertex: false,
+        saw_faces: false,
+    };
     let mut warnings = std::mem::take(&mut h.warnings);
-    let mut vals: Vec<Num> = Vec::new();
-    let mut list: Vec<i64> = Vec::new();
+    let mut scratch = Scratch {
+        vals: Vec::new(),
+        list: Vec::new(),
+    };
     for el in &h.elements {
-        let n = el.count;
         match el.name.as_str() {
-            "vertex" => {
-                saw_vertex = true;
-                let xyz = [el.find(&["x"]), el.find(&["y"]), el.find(&["z"])];
-                let [Some(x), Some(y), Some(z)] = xyz else {
-                    return Err(parse_err("element `vertex` lacks scalar x, y or z".into()));
-                };
-                let uvp = el
-                    .find(&["u", "s", "texture_u"])
-                    .zip(el.find(&["v", "t", "texture_v"]));
-                positions.reserve(capped(n, rd.remaining(), el.min_bytes(!binary) as usize));
-                if uvp.is_some() {
-                    uv = Some(Vec::with_capacity(positions.capacity()));
-                }
-                for i in 0..n {
-                    read_element(&mut rd, el, i, &mut vals, &mut list)?;
-                    let p = Point3::new(vals[x].f64(), vals[y].f64(), vals[z].f64());
-                    if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
-                        return Err(IoError::NonFinite {
-                            path: path.to_string(),
-                            line: rd.line(),
-                            vertex: i as usize,
-                        });
-                    }
-                    positions.push(p);
-                    if let (Some((u, v)), Some(uv)) = (uvp, uv.as_mut()) {
-                        uv.push(Point2::new(vals[u].f64(), vals[v].f64()));
-                    }
-                }
-            }
-            "face" => {
-                saw_faces = true;
-                let Some(li) = el.props.iter().position(|p| {
-                    p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index")
-                }) else {
-                    return Err(IoError::Unsupported {
-                        path: path.to_string(),
-                        format: F,
-                        what: "element `face` without a `vertex_indices` list".into(),
-                    });
-                };
-                if !el.props[li].ty.is_int() {
-                    return Err(parse_err(format!(
-                        "face list `{}` has non-integer index type",
-                        el.props[li].name
-                    )));
-                }
-                let int_scalar = |name: &str| {
-                    el.props
-                        .iter()
-                        .position(|p| p.list.is_none() && p.ty.is_int() && p.name == name)
-                };
-                let rgb = match (int_scalar("red"), int_scalar("green"), int_scalar("blue")) {
-                    (Some(r), Some(g), Some(b)) => Some([r, g, b]),
-                    _ => None,
-                };
-                let ints: Vec<usize> = (0..el.props.len())
-                    .filter(|&k| {
-                        let p = &el.props[k];
-                        p.list.is_none() && p.ty.is_int() && !rgb.is_some_and(|c| c.contains(&k))
-                    })
-                    .collect();
-                let roles = FaceRoles {
-                    list: li,
-                    ints,
-                    rgb,
-                };
-                let cap = capped(n, rd.remaining(), el.min_bytes(!binary) as usize);
-                face_ints = roles
-                    .ints
-                    .iter()
-                    .map(|&k| (el.props[k].name.clone(), Vec::with_capacity(cap)))
-                    .collect();
-                if roles.rgb.is_some() {
-                    colors = Some(Vec::with_capacity(cap));
-                }
-                for i in 0..n {
-                    read_element_face(&mut rd, el, i, &roles, &mut vals, &mut list)?;
-                    faces.begin(rd.line());
-                    for &v in &list {
-                        faces.push(v);
-                    }
-                    for (slot, &k) in face_ints.iter_mut().zip(&roles.ints) {
-                        if let Num::I(v) = vals[k] {
-                            slot.1.push(v);
-                        }
-                    }
-                    if let (Some([r, g, b]), Some(c)) = (roles.rgb, colors.as_mut()) {
-                        let u = |k: usize| match vals[k] {
-                            Num::I(v) => v.clamp(0, 255) as u8,
-                            Num::F(_) => 0,
-                        };
-                        c.push([u(r), u(g), u(b)]);
-                    }
-                }
-            }
+            "vertex" => read_vertices(&mut rd, el, binary, &mut scratch, &mut c)?,
+            "face" => read_faces(&mut rd, el, binary, &mut scratch, &mut c)?,
             "tristrips" => {
-                saw_faces = true;
-                let Some(li) = el
-                    .props
-                    .iter()
-                    .position(|p| p.list.is_some() && p.name == "vertex_indices")
-                else {
-                    return Err(IoError::Unsupported {
-                        path: path.to_string(),
-                        format: F,
-                        what: "element `tristrips` without a `vertex_indices` list".into(),
-                    });
-                };
-                let roles = FaceRoles {
-                    list: li,
-                    ints: Vec::new(),
-                    rgb: None,
-                };
-                for i in 0..n {
-                    read_element_face(&mut rd, el, i, &roles, &mut vals, &mut list)?;
-                    decode_strips(&list, rd.line(), &mut faces);
-                }
+                read_tristrips(&mut rd, el, &mut scratch, &mut c)?;
                 warnings.push(format!("{path}: triangle strips decoded"));
             }
             _ => {
                 if !el.props.is_empty() {
-                    for i in 0..n {
-                        read_element(&mut rd, el, i, &mut vals, &mut list)?;
+                    for i in 0..el.count {
+                        read_element(&mut rd, el, i, &mut scratch.vals, &mut scratch.list)?;
                     }
                 }
                 warnings.push(format!("{path}: PLY element `{}` skipped", el.name));
             }
         }
     }
-    if !saw_vertex {
-        return Err(parse_err("no `vertex` element".into()));
+    loaded_mesh(c, warnings, path)
+}
+
+/// The body after the header: binary as bytes, ASCII as tokens whose line numbers count
+/// from the file's first line.
+fn body<'a>(
+    body_bytes: &'a [u8],
+    binary: bool,
+    big_endian: bool,
+    body_first_line: usize,
+    path: &str,
+) -> Result<Body<'a>, IoError> {
+    if binary {
+        return Ok(Body::Binary {
+            data: body_bytes,
+            pos: 0,
+            big_endian,
+        });
     }
-    if !saw_faces {
+    Ok(Body::Ascii(Tokens::starting_at(
+        as_text(body_bytes, path, F).map_err(|e| match e {
+            IoError::Parse {
+                path,
+                format,
+                line,
+                message,
+            } => IoError::Parse {
+                path,
+                format,
+                line: line + body_first_line - 1,
+                message,
+            },
+            e => e,
+        })?,
+        body_first_line,
+    )))
+}
+
+fn parse_err(path: &str, message: String) -> IoError {
+    IoError::Parse {
+        path: path.to_string(),
+        format: F,
+        line: 0,
+        message,
+    }
+}
+
+/// The `vertex` element: positions, and texture coordinates when it has them.
+fn read_vertices(
+    rd: &mut Reader,
+    el: &Element,
+    binary: bool,
+    scratch: &mut Scratch,
+    c: &mut Contents,
+) -> Result<(), IoError> {
+    let path = rd.path;
+    c.saw_vertex = true;
+    let xyz = [el.find(&["x"]), el.find(&["y"]), el.find(&["z"])];
+    let [Some(x), Some(y), Some(z)] = xyz else {
+        return Err(parse_err(
+            path,
+            "element `vertex` lacks scalar x, y or z".into(),
+        ));
+    };
+    let uvp = el
+        .find(&["u", "s", "texture_u"])
+        .zip(el.find(&["v", "t", "texture_v"]));
+    let positions = &mut c.positions;
+    positions.reserve(capped(
+        el.count,
+        rd.remaining(),
+        el.min_bytes(!binary) as usize,
+    ));
+    if uvp.is_some() {
+        c.uv = Some(Vec::with_capacity(positions.capacity()));
+    }
+    let vals = &mut scratch.vals;
+    for i in 0..el.count {
+        read_element(rd, el, i, vals, &mut scratch.list)?;
+        let p = Point3::new(vals[x].f64(), vals[y].f64(), vals[z].f64());
+        if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+            return Err(IoError::NonFinite {
+                path: path.to_string(),
+                line: rd.line(),
+                vertex: i as usize,
+            });
+        }
+        positions.push(p);
+        if let (Some((u, v)), Some(uv)) = (uvp, c.uv.as_mut()) {
+            uv.push(Point2::new(vals[u].f64(), vals[v].f64()));
+        }
+    }
+    Ok(())
+}
+
+/// The `face` element: the index lists, and the integer properties and colours that follow
+/// each face.
+fn read_faces(
+    rd: &mut Reader,
+    el: &Element,
+    binary: bool,
+    scratch: &mut Scratch,
+    c: &mut Contents,
+) -> Result<(), IoError> {
+    let path = rd.path;
+    c.saw_faces = true;
+    let Some(li) = el
+        .props
+        .iter()
+        .position(|p| p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index"))
+    else {
+        return Err(IoError::Unsupported {
+            path: path.to_string(),
+            format: F,
+            what: "element `face` without a `vertex_indices` list".into(),
+        });
+    };
+    if !el.props[li].ty.is_int() {
+        return Err(parse_err(
+            path,
+            format!(
+                "face list `{}` has non-integer index type",
+                el.props[li].name
+            ),
+        ));
+    }
+    let int_scalar = |name: &str| {
+        el.props
+            .iter()
+            .position(|p| p.list.is_none() && p.ty.is_int() && p.name == name)
+    };
+    let rgb = match (int_scalar("red"), int_scalar("green"), int_scalar("blue")) {
+        (Some(r), Some(g), Some(b)) => Some([r, g, b]),
+        _ => None,
+    };
+    let ints: Vec<usize> = (0..el.props.len())
+        .filter(|&k| {
+            let p = &el.props[k];
+            p.list.is_none() && p.ty.is_int() && !rgb.is_some_and(|c| c.contains(&k))
+        })
+        .collect();
+    let roles = FaceRoles {
+        list: li,
+        ints,
+        rgb,
+    };
+    let cap = capped(el.count, rd.remaining(), el.min_bytes(!binary) as usize);
+    c.face_ints = roles
+        .ints
+        .iter()
+        .map(|&k| (el.props[k].name.clone(), Vec::with_capacity(cap)))
+        .collect();
+    if roles.rgb.is_some() {
+        c.colors = Some(Vec::with_capacity(cap));
+    }
+    let Scratch { vals, list } = scratch;
+    for i in 0..el.count {
+        read_element_face(rd, el, i, &roles, vals, list)?;
+        c.faces.begin(rd.line());
+        for &v in list.iter() {
+            c.faces.push(v);
+        }
+        for (slot, &k) in c.face_ints.iter_mut().zip(&roles.ints) {
+            if let Num::I(v) = vals[k] {
+                slot.1.push(v);
+            }
+        }
+        if let (Some([r, g, b]), Some(colors)) = (roles.rgb, c.colors.as_mut()) {
+            let u = |k: usize| match vals[k] {
+                Num::I(v) => v.clamp(0, 255) as u8,
+                Num::F(_) => 0,
+            };
+            colors.push([u(r), u(g), u(b)]);
+        }
+    }
+    Ok(())
+}
+
+/// The `tristrips` element: each strip decoded into triangles.
+fn read_tristrips(
+    rd: &mut Reader,
+    el: &Element,
+    scratch: &mut Scratch,
+    c: &mut Contents,
+) -> Result<(), IoError> {
+    c.saw_faces = true;
+    let Some(li) = el
+        .props
+        .iter()
+        .position(|p| p.list.is_some() && p.name == "vertex_indices")
+    else {
+        return Err(IoError::Unsupported {
+            path: rd.path.to_string(),
+            format: F,
+            what: "element `tristrips` without a `vertex_indices` list".into(),
+        });
+    };
+    let roles = FaceRoles {
+        list: li,
+        ints: Vec::new(),
+        rgb: None,
+    };
+    for i in 0..el.count {
+        read_element_face(rd, el, i, &roles, &mut scratch.vals, &mut scratch.list)?;
+        decode_strips(&scratch.list, rd.line(), &mut c.faces);
+    }
+    Ok(())
+}
+
+/// The mesh from the elements read, with the face attributes spread over the triangles.
+fn loaded_mesh(c: Contents, mut warnings: Vec<String>, path: &str) -> Result<LoadedMesh, IoError> {
+    if !c.saw_vertex {
+        return Err(parse_err(path, "no `vertex` element".into()));
+    }
+    if !c.saw_faces {
         return Err(IoError::NoFaces {
             path: path.to_string(),
             format: F,
         });
     }
-    let n_v = positions.len();
-    let (mesh, polygons, origin, repeated) = build_mesh(path, F, positions, &faces)?;
+    let n_v = c.positions.len();
+    let (mesh, polygons, origin, repeated) = build_mesh(path, F, c.positions, &c.faces)?;
     if polygons > 0 {
         warnings.push(format!(
             "{path}: {polygons} polygon faces cut into triangles"
@@ -608,12 +723,15 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let spread =
         |v: &Vec<i64>| -> Option<Vec<i64>> { origin.iter().map(|&f| v.get(f).copied()).collect() };
     let attributes = MeshAttributes {
-        face_ints: face_ints
+        face_ints: c
+            .face_ints
             .iter()
             .filter_map(|(name, v)| Some((name.clone(), spread(v)?)))
             .collect(),
-        face_colors: colors.and_then(|c| origin.iter().map(|&f| c.get(f).copied()).collect()),
-        uv: uv.filter(|u| u.len() == n_v),
+        face_colors: c
+            .colors
+            .and_then(|c| origin.iter().map(|&f| c.get(f).copied()).collect()),
+        uv: c.uv.filter(|u| u.len() == n_v),
     };
     Ok(LoadedMesh {
         mesh,

@@ -259,64 +259,12 @@ pub(super) fn fit_vertex(
     if !h.is_finite() || h <= 0.0 {
         return planar(n0);
     }
-    // Least squares z = a u² + b uv + c v² + d u + e v on coordinates scaled by 1/h, so that
-    // all five columns have comparable size (the solution is the same up to the rescaling).
-    let m = local.len();
-    let mut a_mat = DMatrix::<f64>::zeros(m, 5);
-    let mut rhs = DVector::<f64>::zeros(m);
-    for (r, q) in local.iter().enumerate() {
-        let (u, w, z) = (q.x / h, q.y / h, q.z / h);
-        a_mat[(r, 0)] = u * u;
-        a_mat[(r, 1)] = u * w;
-        a_mat[(r, 2)] = w * w;
-        a_mat[(r, 3)] = u;
-        a_mat[(r, 4)] = w;
-        rhs[r] = z;
-    }
-    let svd = a_mat.svd(true, true);
-    let smax = svd.singular_values.max();
-    let Ok(sol) = svd.solve(&rhs, smax * 1e-12) else {
+    let Some((a, b, c, d, e)) = fit_quadric(&local, h) else {
         return planar(n0);
     };
-    // Undo the scaling: z/h = a'(u/h)² + … ⇒ a = a'/h (second order), d = d' (first order).
-    let (a, b, c, d, e) = (sol[0] / h, sol[1] / h, sol[2] / h, sol[3], sol[4]);
-    if ![a, b, c, d, e].iter().all(|x| x.is_finite()) {
-        return planar(n0);
-    }
-    // Fundamental forms of the graph (u, v, f(u, v)) at the origin: I = [[E, F], [F, G]],
-    // II = [[L, M], [M, N]] with the fitted surface's unit normal (−d, −e, 1)/w.
-    let w = (1.0 + d * d + e * e).sqrt();
-    let (ee, ff, gg) = (1.0 + d * d, d * e, 1.0 + e * e);
-    let (l, m_, nn) = (2.0 * a / w, b / w, 2.0 * c / w);
-    // Principal curvatures: eigenvalues of the shape operator I⁻¹ II (the generalised symmetric
-    // problem II x = λ I x, solved through the Cholesky factor I = R Rᵀ: S = R⁻¹ II R⁻ᵀ,
-    // x = R⁻ᵀ y). libigl symmetrises I⁻¹ II instead (its off-diagonal M E − L F on both sides),
-    // which is exact only when d = e = 0 and then depends on the frame's tangent axis; the exact
-    // operator does not, so the result is independent of how (t₁, t₂) is chosen.
-    let r11 = ee.sqrt();
-    let r21 = ff / r11;
-    let r22 = (gg - r21 * r21).sqrt();
-    let Some(r_inv) = Matrix2::new(r11, 0.0, r21, r22).try_inverse() else {
+    let Some(pairs) = principal_pairs((a, b, c, d, e), t1, t2) else {
         return planar(n0);
     };
-    let second = Matrix2::new(l, m_, m_, nn);
-    let s = r_inv * second * r_inv.transpose();
-    let eig = SymmetricEigen::new((s + s.transpose()) * 0.5);
-    // k = −λ: the graph of a sphere seen from its outward normal has f = −(u²+v²)/2r, λ = −1/r.
-    // Directions: the 3D tangent x_u x¹ + x_v x² = (t₁ + d n₀) x¹ + (t₂ + e n₀) x², projected on
-    // the tangent plane of n₀ (as libigl reports them), where the metric lives (Sec. 4.1 builds
-    // M from (d₁, d₂, d₁ × d₂); Eq. 4 projects onto the plane of d₁, d₂).
-    let mut pairs: Vec<(f64, Vector3<f64>)> = (0..2)
-        .map(|i| {
-            let x = r_inv.transpose() * eig.eigenvectors.column(i);
-            (-eig.eigenvalues[i], t1 * x[0] + t2 * x[1])
-        })
-        .collect();
-    pairs.sort_by(|p, q| {
-        q.0.abs()
-            .total_cmp(&p.0.abs())
-            .then_with(|| q.0.total_cmp(&p.0))
-    });
     let (k1, k2) = (pairs[0].0, pairs[1].0);
     if !(k1.is_finite() && k2.is_finite()) {
         return planar(n0);
@@ -339,6 +287,77 @@ pub(super) fn fit_vertex(
         d2,
         normal,
     }
+}
+
+/// The quadric `z = a u² + b uv + c v² + d u + e v` through the ring's local coordinates
+/// (least squares), `h` their largest tangential distance; `None` when it has no finite fit.
+fn fit_quadric(local: &[Vector3<f64>], h: f64) -> Option<(f64, f64, f64, f64, f64)> {
+    // Least squares z = a u² + b uv + c v² + d u + e v on coordinates scaled by 1/h, so that
+    // all five columns have comparable size (the solution is the same up to the rescaling).
+    let m = local.len();
+    let mut a_mat = DMatrix::<f64>::zeros(m, 5);
+    let mut rhs = DVector::<f64>::zeros(m);
+    for (r, q) in local.iter().enumerate() {
+        let (u, w, z) = (q.x / h, q.y / h, q.z / h);
+        a_mat[(r, 0)] = u * u;
+        a_mat[(r, 1)] = u * w;
+        a_mat[(r, 2)] = w * w;
+        a_mat[(r, 3)] = u;
+        a_mat[(r, 4)] = w;
+        rhs[r] = z;
+    }
+    let svd = a_mat.svd(true, true);
+    let smax = svd.singular_values.max();
+    let sol = svd.solve(&rhs, smax * 1e-12).ok()?;
+    // Undo the scaling: z/h = a'(u/h)² + … ⇒ a = a'/h (second order), d = d' (first order).
+    let (a, b, c, d, e) = (sol[0] / h, sol[1] / h, sol[2] / h, sol[3], sol[4]);
+    if ![a, b, c, d, e].iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    Some((a, b, c, d, e))
+}
+
+/// The fitted graph's principal curvatures with their directions in the tangent plane of
+/// `n₀` (frame `t1`, `t2`), largest magnitude first; `None` when the first fundamental form
+/// has no Cholesky inverse.
+fn principal_pairs(
+    (a, b, c, d, e): (f64, f64, f64, f64, f64),
+    t1: Vector3<f64>,
+    t2: Vector3<f64>,
+) -> Option<Vec<(f64, Vector3<f64>)>> {
+    // Fundamental forms of the graph (u, v, f(u, v)) at the origin: I = [[E, F], [F, G]],
+    // II = [[L, M], [M, N]] with the fitted surface's unit normal (−d, −e, 1)/w.
+    let w = (1.0 + d * d + e * e).sqrt();
+    let (ee, ff, gg) = (1.0 + d * d, d * e, 1.0 + e * e);
+    let (l, m_, nn) = (2.0 * a / w, b / w, 2.0 * c / w);
+    // Principal curvatures: eigenvalues of the shape operator I⁻¹ II (the generalised symmetric
+    // problem II x = λ I x, solved through the Cholesky factor I = R Rᵀ: S = R⁻¹ II R⁻ᵀ,
+    // x = R⁻ᵀ y). libigl symmetrises I⁻¹ II instead (its off-diagonal M E − L F on both sides),
+    // which is exact only when d = e = 0 and then depends on the frame's tangent axis; the exact
+    // operator does not, so the result is independent of how (t₁, t₂) is chosen.
+    let r11 = ee.sqrt();
+    let r21 = ff / r11;
+    let r22 = (gg - r21 * r21).sqrt();
+    let r_inv = Matrix2::new(r11, 0.0, r21, r22).try_inverse()?;
+    let second = Matrix2::new(l, m_, m_, nn);
+    let s = r_inv * second * r_inv.transpose();
+    let eig = SymmetricEigen::new((s + s.transpose()) * 0.5);
+    // k = −λ: the graph of a sphere seen from its outward normal has f = −(u²+v²)/2r, λ = −1/r.
+    // Directions: the 3D tangent x_u x¹ + x_v x² = (t₁ + d n₀) x¹ + (t₂ + e n₀) x², projected on
+    // the tangent plane of n₀ (as libigl reports them), where the metric lives (Sec. 4.1 builds
+    // M from (d₁, d₂, d₁ × d₂); Eq. 4 projects onto the plane of d₁, d₂).
+    let mut pairs: Vec<(f64, Vector3<f64>)> = (0..2)
+        .map(|i| {
+            let x = r_inv.transpose() * eig.eigenvectors.column(i);
+            (-eig.eigenvalues[i], t1 * x[0] + t2 * x[1])
+        })
+        .collect();
+    pairs.sort_by(|p, q| {
+        q.0.abs()
+            .total_cmp(&p.0.abs())
+            .then_with(|| q.0.total_cmp(&p.0))
+    });
+    Some(pairs)
 }
 
 /// Principal curvatures and directions at every vertex of `mesh` (quadric fit over

@@ -27,6 +27,7 @@ use super::cone_fit::cone_error;
 use super::growth_cost::{growth_cost, ConeOptions};
 use super::{Cone, PatchContext};
 use crate::ids::{EdgeKey, FaceId, VertexId};
+use crate::mesh::TriMesh;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -346,23 +347,7 @@ impl Grown<'_, '_> {
             }
             if top.cost.is_nan() || top.cost >= opts.c_max {
                 // Refresh stale entries before giving up.
-                let entries: Vec<Entry> = heap.drain().collect();
-                let mut any_stale = false;
-                for e in entries {
-                    if patch.contains(e.face) {
-                        continue;
-                    }
-                    if e.version != patch.len() {
-                        any_stale = true;
-                        heap.push(Entry {
-                            cost: cost_of(&*patch, &*distance, e.face),
-                            face: e.face,
-                            version: patch.len(),
-                        });
-                    } else {
-                        heap.push(e);
-                    }
-                }
+                let any_stale = refresh_stale(&mut heap, patch, |f| cost_of(patch, distance, f));
                 if !any_stale {
                     break;
                 }
@@ -379,36 +364,7 @@ impl Grown<'_, '_> {
             let d_t = d_outside(&*patch, &*distance, top.face);
             let d_t = if d_t.is_finite() { d_t } else { 0.0 };
             distance.insert(top.face, d_t);
-            // Label-setting (Dijkstra) from the new face over the distances it lowers: each
-            // face's distance falls at most once per added face (a stack-order relaxation
-            // lowers the same faces many times over; notes/scaling.md). Ordered like the
-            // growth heap: least distance first, then face id.
-            let mut front = BinaryHeap::from([Entry {
-                cost: d_t,
-                face: top.face,
-                version: 0,
-            }]);
-            while let Some(Entry {
-                cost: df, face: f, ..
-            }) = front.pop()
-            {
-                if distance.get(&f).is_some_and(|&d| d < df) {
-                    continue;
-                }
-                let cf = centroid(f);
-                let nbrs: Vec<FaceId> = patch.patch_neighbors(f).map(|(_, g)| g).collect();
-                for g in nbrs {
-                    let cand = df + (centroid(g) - cf).norm();
-                    if cand < distance.get(&g).copied().unwrap_or(f64::INFINITY) {
-                        distance.insert(g, cand);
-                        front.push(Entry {
-                            cost: cand,
-                            face: g,
-                            version: 0,
-                        });
-                    }
-                }
-            }
+            relax_from(mesh, patch, distance, top.face, d_t);
             for i in 0..3 {
                 if let Some(g) = ctx.topology.neighbor(top.face, i) {
                     if !patch.contains(g) && addable(g) {
@@ -422,5 +378,73 @@ impl Grown<'_, '_> {
             }
         }
         costs.len() - before
+    }
+}
+
+/// Re-cost the heap's entries made before the patch last grew (`cost` of a face, at the
+/// current patch); whether there were any.
+fn refresh_stale(
+    heap: &mut BinaryHeap<Entry>,
+    patch: &DiskPatch,
+    cost: impl Fn(FaceId) -> f64,
+) -> bool {
+    let entries: Vec<Entry> = heap.drain().collect();
+    let mut any_stale = false;
+    for e in entries {
+        if patch.contains(e.face) {
+            continue;
+        }
+        if e.version != patch.len() {
+            any_stale = true;
+            heap.push(Entry {
+                cost: cost(e.face),
+                face: e.face,
+                version: patch.len(),
+            });
+        } else {
+            heap.push(e);
+        }
+    }
+    any_stale
+}
+
+/// The patch's distances `D(s_P, ·)` after `face` joined at distance `d`.
+fn relax_from(
+    mesh: &TriMesh,
+    patch: &DiskPatch,
+    distance: &mut FxHashMap<FaceId, f64>,
+    face: FaceId,
+    d: f64,
+) {
+    let centroid = |f: FaceId| mesh.face_centroid(f);
+    // Label-setting (Dijkstra) from the new face over the distances it lowers: each
+    // face's distance falls at most once per added face (a stack-order relaxation
+    // lowers the same faces many times over; notes/scaling.md). Ordered like the
+    // growth heap: least distance first, then face id.
+    let mut front = BinaryHeap::from([Entry {
+        cost: d,
+        face,
+        version: 0,
+    }]);
+    while let Some(Entry {
+        cost: df, face: f, ..
+    }) = front.pop()
+    {
+        if distance.get(&f).is_some_and(|&d| d < df) {
+            continue;
+        }
+        let cf = centroid(f);
+        let nbrs: Vec<FaceId> = patch.patch_neighbors(f).map(|(_, g)| g).collect();
+        for g in nbrs {
+            let cand = df + (centroid(g) - cf).norm();
+            if cand < distance.get(&g).copied().unwrap_or(f64::INFINITY) {
+                distance.insert(g, cand);
+                front.push(Entry {
+                    cost: cand,
+                    face: g,
+                    version: 0,
+                });
+            }
+        }
     }
 }

@@ -223,75 +223,18 @@ fn sizes_on_target(ctx: &RunContext<'_>, state: &LoopState) -> Sizes {
 pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
     let plan = ctx.plan;
     let reference = ctx.quality_field.reference();
-    let cert = &state.counters.cert;
-    let mut warnings = Vec::new();
-    if plan.coarse {
-        warnings.push(Warning::CoarseProfile {
-            forced: plan.options.coarse_input == CoarseInput::On,
-            expected_faces: plan.expected,
-            expected_faces_fidelity: plan.expected_fidelity,
-        });
-    }
-    if !state.fallbacks.failures.is_empty() || state.fallbacks.kept_faces > 0 {
-        warnings.push(Warning::FailedAttempts {
-            attempts: state.fallbacks.failures.len(),
-            kept_faces: state.fallbacks.kept_faces,
-        });
-    }
-    if let Some((patches, faces)) = state.over_face_budget_at {
-        warnings.push(Warning::FaceBudget {
-            patches,
-            faces,
-            budget: (plan.options.face_budget
-                * plan.expected_fidelity.max(state.faces_per_sweep as f64))
-                as usize,
-        });
-    }
-    if let Some((patches, work)) = state.over_work_budget_at {
-        warnings.push(Warning::WorkBudget {
-            patches,
-            work,
-            budget: state.work_budget(ctx) as usize,
-            stopped: state.work_stopped,
-            unprocessed: state.work.unprocessed(),
-        });
-    }
-    if state.budget_exhausted {
-        warnings.push(Warning::PatchBudget {
-            patches: state.patches,
-            unprocessed: state.work.unprocessed(),
-        });
-    }
-    let steps = state.improvement.iter().flat_map(|i| &i.steps);
-    for s in steps.clone().filter(|s| s.counts.budget_exhausted) {
-        warnings.push(Warning::ImproverBudget {
-            improver: s.name.clone(),
-            patches: s.counts.patches,
-        });
-    }
-    let surface_counts = steps.fold(crate::improve::ImproverCounts::default(), |mut c, s| {
-        c.flips += s.counts.flips;
-        c.moves += s.counts.moves;
-        c
-    });
-    if let Some(input_pairs) = cert.input_self_intersecting_pairs {
-        warnings.push(Warning::InputSelfIntersects {
-            input_pairs,
-            output_pairs: cert.self_intersecting_pairs,
-        });
-    }
+    let warnings = run_warnings(ctx, &state);
+    let surface_counts = state.improvement.iter().flat_map(|i| &i.steps).fold(
+        crate::improve::ImproverCounts::default(),
+        |mut c, s| {
+            c.flips += s.counts.flips;
+            c.moves += s.counts.moves;
+            c
+        },
+    );
     let metrics = state.vertex_metrics(ctx);
     let seams = seam_quality(&state.work, &state.face_patch, &metrics);
-    let regions = RegionsReport {
-        count: state.regions.map_or(1, |r| r.0),
-        declined_cut_edge: state.regions_declined,
-        cuts: state.regions.map(|(_, band_from)| {
-            let band: Vec<bool> = (state.face_patch.iter())
-                .map(|p| p.is_some_and(|p| p.idx() >= band_from))
-                .collect();
-            split_quality(&state.work.mesh, &metrics, &band)
-        }),
-    };
+    let regions = regions_report(&state, &metrics);
     let sizes = sizes_on_target(ctx, &state);
     let out_topo = Topology::build(&state.work.mesh);
     let boundary_distance = crate::boundary::curve_distance(
@@ -344,5 +287,82 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
         curves: ctx.curves.clone(),
         report,
         remesh_metric: ctx.field().vertex_metrics().to_vec(),
+    }
+}
+
+/// The run's warnings, in the report's order: the coarse profile, failed attempts, the
+/// budgets that stopped or limited it, and an input that intersects itself.
+fn run_warnings(ctx: &RunContext<'_>, state: &LoopState) -> Vec<Warning> {
+    let plan = ctx.plan;
+    let cert = &state.counters.cert;
+    let mut warnings = Vec::new();
+    if plan.coarse {
+        warnings.push(Warning::CoarseProfile {
+            forced: plan.options.coarse_input == CoarseInput::On,
+            expected_faces: plan.expected,
+            expected_faces_fidelity: plan.expected_fidelity,
+        });
+    }
+    if !state.fallbacks.failures.is_empty() || state.fallbacks.kept_faces > 0 {
+        warnings.push(Warning::FailedAttempts {
+            attempts: state.fallbacks.failures.len(),
+            kept_faces: state.fallbacks.kept_faces,
+        });
+    }
+    if let Some((patches, faces)) = state.over_face_budget_at {
+        warnings.push(Warning::FaceBudget {
+            patches,
+            faces,
+            budget: (plan.options.face_budget
+                * plan.expected_fidelity.max(state.faces_per_sweep as f64))
+                as usize,
+        });
+    }
+    if let Some((patches, work)) = state.over_work_budget_at {
+        warnings.push(Warning::WorkBudget {
+            patches,
+            work,
+            budget: state.work_budget(ctx) as usize,
+            stopped: state.work_stopped,
+            unprocessed: state.work.unprocessed(),
+        });
+    }
+    if state.budget_exhausted {
+        warnings.push(Warning::PatchBudget {
+            patches: state.patches,
+            unprocessed: state.work.unprocessed(),
+        });
+    }
+    for s in state
+        .improvement
+        .iter()
+        .flat_map(|i| &i.steps)
+        .filter(|s| s.counts.budget_exhausted)
+    {
+        warnings.push(Warning::ImproverBudget {
+            improver: s.name.clone(),
+            patches: s.counts.patches,
+        });
+    }
+    if let Some(input_pairs) = cert.input_self_intersecting_pairs {
+        warnings.push(Warning::InputSelfIntersects {
+            input_pairs,
+            output_pairs: cert.self_intersecting_pairs,
+        });
+    }
+    warnings
+}
+
+/// The regions' count, and the quality across their cuts when there were several.
+fn regions_report(state: &LoopState, metrics: &[nalgebra::Matrix3<f64>]) -> RegionsReport {
+    RegionsReport {
+        count: state.regions.map_or(1, |r| r.0),
+        declined_cut_edge: state.regions_declined,
+        cuts: state.regions.map(|(_, band_from)| {
+            let band: Vec<bool> = (state.face_patch.iter())
+                .map(|p| p.is_some_and(|p| p.idx() >= band_from))
+                .collect();
+            split_quality(&state.work.mesh, metrics, &band)
+        }),
     }
 }

@@ -13,6 +13,7 @@ use crate::metric::MetricField;
 use crate::quality::{face_qualities, stats_of, triangle_quality, TriangleQuality};
 use crate::stitch::{PatchVertex, Replacement, WorkingMesh};
 use std::time::Instant;
+use nalgebra::Point3;
 
 /// The pipeline's side of [`crate::improve::ImproveRun`]: the run's context and state.
 struct Host<'r> {
@@ -121,7 +122,7 @@ fn patch_pass(
             } if !accept(
                 &qualities_of_faces(ctx, state, &faces),
                 &qualities_of_candidate(ctx, state, &refined.replacement),
-            ) =>
+            ) || !keeps_the_surface(ctx, state, &faces, &refined.replacement) =>
             {
                 pass.rejected += 1;
                 PatchOutcome::Kept { faces, record }
@@ -133,6 +134,49 @@ fn patch_pass(
     }
     state.work.processed.iter_mut().for_each(|p| *p = true);
     Ok(pass)
+}
+
+/// A candidate with fewer faces than it replaces (the planar updates collapsed edges) keeps
+/// the surface as the relocation does: every watched point (the replaced faces' vertices and
+/// the corners of the reference faces they lie on) ends within the fidelity tolerance of the
+/// candidate, or no farther than it was from the replaced faces. A collapse must not cut off
+/// a tip (a cow's teat) that the vertex it removed held, which the qualities `accept` sees
+/// cannot tell. Without the control (`--hausd 0`) any candidate keeps the surface.
+fn keeps_the_surface(
+    ctx: &RunContext<'_>,
+    state: &LoopState,
+    faces: &[FaceId],
+    candidate: &Replacement,
+) -> bool {
+    let tol = passes_tolerance(ctx.plan.eps);
+    if candidate.triangles.len() >= faces.len() || !tol.is_finite() {
+        return true;
+    }
+    let work = &state.work;
+    let reference = ctx.quality_field.reference();
+    let position = |v: PatchVertex| match v {
+        PatchVertex::Existing(u) => *work.mesh.position(u),
+        PatchVertex::New(i) => candidate.new_positions[i as usize],
+    };
+    let new: Vec<[Point3<f64>; 3]> = candidate.triangles.iter().map(|t| t.map(position)).collect();
+    let old: Vec<[Point3<f64>; 3]> = faces
+        .iter()
+        .map(|f| work.mesh.triangles[f.idx()].map(|v| work.mesh.positions[v.idx()]))
+        .collect();
+    let distance = |p: &Point3<f64>, ts: &[[Point3<f64>; 3]]| {
+        ts.iter()
+            .map(|t| crate::improve::point_triangle_distance(p, t))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let vertices = faces.iter().flat_map(|f| work.mesh.triangles[f.idx()]);
+    vertices.clone().all(|v| distance(&work.mesh.positions[v.idx()], &new) <= tol)
+        && vertices
+            .flat_map(|v| reference.triangles[work.locations[v.idx()].face.idx()])
+            .all(|r| {
+                let p = reference.positions[r.idx()];
+                let d = distance(&p, &new);
+                d <= tol || d <= distance(&p, &old)
+            })
 }
 
 /// How far the surface passes may move the surface: the fidelity tolerance, or no bound when

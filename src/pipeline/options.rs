@@ -140,16 +140,16 @@ impl Cancel {
     }
 }
 
-/// The default of [`RemeshOptions::batch`]: one patch at a time (the paper's loop), until
-/// batches are shown to keep the quality rows (BENCHMARKS.md, "parallel patches").
+/// The default of [`RemeshOptions::batch`]: one patch at a time, the paper's loop (why not
+/// more: notes/doc-comments.md).
 pub const DEFAULT_BATCH: usize = 1;
 
 /// The face budget of a run, as a multiple of the larger of the input's face count and the
 /// output expected with the a-priori fidelity scaling ([`super::Plan::expected_fidelity`]).
 /// Past it the fidelity control stops refining and no further sweep starts
-/// ([`Warning::FaceBudget`](super::Warning::FaceBudget)): above what any legitimate run
-/// needs, so that a run whose refinement runs away ends with a warning instead of running
-/// for hours (the measurements: paper-notes "Coarse inputs", notes/real-world-inputs.md).
+/// ([`Warning::FaceBudget`](super::Warning::FaceBudget)), so that a run whose refinement
+/// runs away ends with a warning instead of running for hours (why 12:
+/// notes/doc-comments.md).
 pub const FACE_BUDGET: f64 = 12.0;
 
 /// The work budget of a run ([`RemeshOptions::work_budget`]): faces handled by patch attempts,

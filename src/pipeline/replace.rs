@@ -4,7 +4,7 @@
 use super::context::{a_priori_at, LoopState, RunContext};
 use super::debug::write_debug;
 use super::error::{PipelineError, Stage, StageError};
-use super::records::FailedAttempt;
+use super::records::{FailedAttempt, PatchRecord};
 use super::step::{PatchOutcome, StepLog};
 use crate::fidelity::Refined;
 use crate::ids::{FaceId, PatchId, VertexId};
@@ -36,6 +36,78 @@ pub fn replace_batch(
     state: &mut LoopState,
     outcomes: Vec<(PatchOutcome, StepLog)>,
 ) -> Result<(), PipelineError> {
+    let (crossing, deferred) = deferred_patches(ctx, state, &outcomes);
+    let Numbered {
+        remeshed,
+        kept_faces,
+        records,
+    } = number_patches(state, outcomes, &crossing, &deferred);
+    for f in &kept_faces {
+        state.work.processed[f.idx()] = true;
+    }
+    let t0 = Instant::now();
+    // Vertices of the faces the patches remove (their boundaries and interiors): with the
+    // new faces' vertices, every vertex whose fan changed.
+    let mut touched: Vec<VertexId> = remeshed
+        .iter()
+        .flat_map(|r| &r.1)
+        .filter(|f| f.idx() < state.work.mesh.n_faces())
+        .flat_map(|f| state.work.mesh.triangles[f.idx()])
+        .collect();
+    let new_faces = stitch_batch(state, &remeshed)?;
+    state.counters.times.stitch += t0.elapsed().as_secs_f64();
+    let gone: Vec<FaceId> = remeshed.iter().flat_map(|r| r.1.iter().copied()).collect();
+    follow_stitched(ctx, state, remeshed, &gone, &new_faces)?;
+    debug_assert_eq!(state.bound.len(), state.work.mesh.n_vertices());
+    debug_assert_eq!(state.face_patch.len(), state.work.mesh.n_faces());
+    // The stitched faces join the face index (the kept ones are listed already).
+    if let Some(near) = &mut state.near {
+        near.insert(&state.work.mesh, new_faces.iter().flatten().copied());
+    }
+    let all_new: Vec<FaceId> = new_faces.into_iter().flatten().chain(kept_faces).collect();
+    touched.extend(
+        all_new
+            .iter()
+            .filter(|f| f.idx() < state.work.mesh.n_faces())
+            .flat_map(|f| state.work.mesh.triangles[f.idx()]),
+    );
+    if let Some(first) = records.first() {
+        let (pid, seed) = (first.id, first.seed);
+        let batch = Batch {
+            pid,
+            seed,
+            patches: records.len(),
+            removed: &gone,
+            new_faces: &all_new,
+        };
+        certify_after_batch(ctx, state, batch, touched)?;
+    }
+    state.patches += records.len();
+    state.records.extend(records);
+    Ok(())
+}
+
+/// A patch stitched in: its id, the faces it removes, its refined replacement, its seed.
+type Remeshed = (PatchId, Vec<FaceId>, Refined, VertexId);
+
+/// The batch's patches under their ids.
+struct Numbered {
+    /// The remeshed patches to stitch, in batch order.
+    remeshed: Vec<Remeshed>,
+    /// The faces of the patches kept as they were.
+    kept_faces: Vec<FaceId>,
+    /// One record per patch not deferred.
+    records: Vec<PatchRecord>,
+}
+
+/// The pairs of patches (batch indices) whose new faces may cross, checked only for an
+/// embedded input, and which patches are deferred: in order, a patch is deferred when it
+/// crosses an accepted earlier one.
+fn deferred_patches(
+    ctx: &RunContext<'_>,
+    state: &mut LoopState,
+    outcomes: &[(PatchOutcome, StepLog)],
+) -> (Vec<(usize, usize)>, Vec<bool>) {
     let crossing = match ctx.embedded_input {
         true => {
             let candidates: Vec<(usize, &Replacement)> = outcomes
@@ -57,15 +129,25 @@ pub fn replace_batch(
         }
         false => Vec::new(),
     };
-    // In order: a patch is deferred when it crosses an accepted earlier one.
     let mut deferred = vec![false; outcomes.len()];
     for &(j, k) in &crossing {
         if !deferred[j] {
             deferred[k] = true;
         }
     }
+    (crossing, deferred)
+}
+
+/// The patches numbered in batch order (deferred ones record their failure under the id the
+/// next patch takes), their logs merged into the run's.
+fn number_patches(
+    state: &mut LoopState,
+    outcomes: Vec<(PatchOutcome, StepLog)>,
+    crossing: &[(usize, usize)],
+    deferred: &[bool],
+) -> Numbered {
     let first_id = state.patches;
-    let mut remeshed: Vec<(PatchId, Vec<FaceId>, Refined, VertexId)> = Vec::new();
+    let mut remeshed: Vec<Remeshed> = Vec::new();
     let mut kept_faces: Vec<FaceId> = Vec::new();
     let mut records = Vec::new();
     for (k, (outcome, mut log)) in outcomes.into_iter().enumerate() {
@@ -108,45 +190,53 @@ pub fn replace_batch(
             }
         }
     }
-    for f in &kept_faces {
-        state.work.processed[f.idx()] = true;
+    Numbered {
+        remeshed,
+        kept_faces,
+        records,
     }
-    let t0 = Instant::now();
-    // Vertices of the faces the patches remove (their boundaries and interiors): with the
-    // new faces' vertices, every vertex whose fan changed.
-    let mut touched: Vec<VertexId> = remeshed
-        .iter()
-        .flat_map(|r| &r.1)
-        .filter(|f| f.idx() < state.work.mesh.n_faces())
-        .flat_map(|f| state.work.mesh.triangles[f.idx()])
-        .collect();
+}
+
+/// Stitch the remeshed patches into the working mesh; the new faces of each. A failure
+/// names the batch's first patch.
+fn stitch_batch(
+    state: &mut LoopState,
+    remeshed: &[Remeshed],
+) -> Result<Vec<Vec<FaceId>>, PipelineError> {
     let batch: Vec<(&[FaceId], &Replacement)> = remeshed
         .iter()
         .map(|r| (r.1.as_slice(), &r.2.replacement))
         .collect();
     let stitched = stitch_all(&mut state.work, &batch);
-    let new_faces = match stitched {
-        Ok(n) => n,
-        Err(e) => {
-            let r = &remeshed[0];
-            return Err(PipelineError::Stage {
-                patch: r.0,
-                seed: Some(r.3),
-                stage: Stage::Stitching,
-                source: e.into(),
-            });
+    stitched.map_err(|e| {
+        let r = &remeshed[0];
+        PipelineError::Stage {
+            patch: r.0,
+            seed: Some(r.3),
+            stage: Stage::Stitching,
+            source: e.into(),
         }
-    };
-    state.counters.times.stitch += t0.elapsed().as_secs_f64();
+    })
+}
+
+/// The per-vertex and per-face state follows the stitched patches: the `removed` faces'
+/// provenance goes, each new vertex gets its a-priori fidelity bound and factor, each new
+/// face its patch.
+fn follow_stitched(
+    ctx: &RunContext<'_>,
+    state: &mut LoopState,
+    remeshed: Vec<Remeshed>,
+    removed: &[FaceId],
+    new_faces: &[Vec<FaceId>],
+) -> Result<(), PipelineError> {
+    drop_provenance(&mut state.face_patch, removed);
     let reference = ctx.quality_field.reference();
     let mut n = state.work.mesh.n_vertices()
         - remeshed
             .iter()
             .map(|r| r.2.replacement.new_positions.len())
             .sum::<usize>();
-    let gone: Vec<FaceId> = remeshed.iter().flat_map(|r| r.1.iter().copied()).collect();
-    drop_provenance(&mut state.face_patch, &gone);
-    for ((pid, _, refined, seed), faces) in remeshed.into_iter().zip(&new_faces) {
+    for ((pid, _, refined, seed), faces) in remeshed.into_iter().zip(new_faces) {
         n += refined.replacement.new_positions.len();
         for (k, loc) in refined.replacement.new_locations.iter().enumerate() {
             let rounds = refined.factors.new.get(k).copied().unwrap_or(1.0);
@@ -165,32 +255,6 @@ pub fn replace_batch(
             })?;
         state.face_patch.extend(faces.iter().map(|_| Some(pid)));
     }
-    debug_assert_eq!(state.bound.len(), state.work.mesh.n_vertices());
-    debug_assert_eq!(state.face_patch.len(), state.work.mesh.n_faces());
-    // The stitched faces join the face index (the kept ones are listed already).
-    if let Some(near) = &mut state.near {
-        near.insert(&state.work.mesh, new_faces.iter().flatten().copied());
-    }
-    let all_new: Vec<FaceId> = new_faces.into_iter().flatten().chain(kept_faces).collect();
-    touched.extend(
-        all_new
-            .iter()
-            .filter(|f| f.idx() < state.work.mesh.n_faces())
-            .flat_map(|f| state.work.mesh.triangles[f.idx()]),
-    );
-    if let Some(first) = records.first() {
-        let (pid, seed) = (first.id, first.seed);
-        let batch = Batch {
-            pid,
-            seed,
-            patches: records.len(),
-            removed: &gone,
-            new_faces: &all_new,
-        };
-        certify_after_batch(ctx, state, batch, touched)?;
-    }
-    state.patches += records.len();
-    state.records.extend(records);
     Ok(())
 }
 

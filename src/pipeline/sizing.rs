@@ -62,33 +62,8 @@ impl Plan {
             return Err(PipelineError::EmptyInput);
         }
         options.validate()?;
-        let l_avg = crate::quality::edge_length_average(reference, field.vertex_metrics());
-        let l_tar = match options.target {
-            TargetLength::Factor(f) => f * l_avg,
-            TargetLength::Absolute(l) => l,
-        };
-        if !(l_tar.is_finite() && l_tar > 0.0) {
-            // The error names where the value came from: the option, or the input's own edge
-            // lengths (a mesh whose size over- or underflows, or a metric that vanishes).
-            return Err(PipelineError::BadTarget {
-                l_tar,
-                target: options.target,
-                l_avg,
-            });
-        }
-        let sized = match options.sizes.any() {
-            true => {
-                let m = apply_sizes(
-                    reference,
-                    field.vertex_metrics(),
-                    l_tar,
-                    1.0,
-                    &options.sizes,
-                );
-                Some(field.with_metrics(m).map_err(PipelineError::SizedMetric)?)
-            }
-            false => None,
-        };
+        let (l_avg, l_tar) = target_length(field, options)?;
+        let sized = sized_metric(field, l_tar, options)?;
         let field = sized.as_ref().unwrap_or(field);
         let expected = expected_faces(reference, field.vertex_metrics(), &[], l_tar);
         // A target far below the input's size would run for hours and exhaust memory: refuse
@@ -120,37 +95,9 @@ impl Plan {
         } else {
             options.clone()
         };
-        // Curved feature lines refine the faces beside them (the a-priori scaling stops at
-        // creases), after the profile is chosen: a part's creases are no sign of a coarse input.
-        let feature_edges = options.features.edges(reference, topo);
-        if !fid_scale.is_empty() && !feature_edges.is_empty() {
-            let crease = crate::features::crease_scale(
-                reference,
-                &feature_edges,
-                field.vertex_metrics(),
-                l_tar,
-                options.fidelity.max_deviation,
-                min_edge,
-            );
-            for (f, c) in fid_scale.iter_mut().zip(crease) {
-                *f = f.max(c);
-            }
-        }
-        let scaled = if fid_scale.is_empty() {
-            None
-        } else {
-            let metrics = field
-                .vertex_metrics()
-                .iter()
-                .zip(&fid_scale)
-                .map(|(m, f)| m * *f)
-                .collect();
-            Some(
-                field
-                    .with_metrics(metrics)
-                    .map_err(PipelineError::FidelityMetric)?,
-            )
-        };
+        let feature_edges =
+            refine_beside_features(field, topo, &options, (l_tar, min_edge), &mut fid_scale);
+        let scaled = scaled_metric(field, &fid_scale)?;
         Ok(Plan {
             faces_in: reference.n_faces(),
             eps: options.fidelity.max_deviation,
@@ -188,6 +135,105 @@ impl Plan {
     pub fn remesh_field<'a>(&'a self, input: &'a MetricField) -> &'a MetricField {
         self.scaled.as_ref().unwrap_or(self.quality_field(input))
     }
+}
+
+/// The input's mean metric edge length `L_avg` and the target `L_tar` (Sec. 3.1): the factor
+/// times `L_avg`, or the absolute length. An error names where a target that is not a finite
+/// positive number came from.
+fn target_length(
+    field: &MetricField,
+    options: &RemeshOptions,
+) -> Result<(f64, f64), PipelineError> {
+    let reference = field.reference();
+    let l_avg = crate::quality::edge_length_average(reference, field.vertex_metrics());
+    let l_tar = match options.target {
+        TargetLength::Factor(f) => f * l_avg,
+        TargetLength::Absolute(l) => l,
+    };
+    if !(l_tar.is_finite() && l_tar > 0.0) {
+        // Name where the value came from: the option, or the input's own edge lengths
+        // (a mesh whose size over- or underflows, or a metric that vanishes).
+        return Err(PipelineError::BadTarget {
+            l_tar,
+            target: options.target,
+            l_avg,
+        });
+    }
+    Ok((l_avg, l_tar))
+}
+
+/// The metric with the size controls ([`RemeshOptions::sizes`]) applied, when they are on.
+fn sized_metric(
+    field: &MetricField,
+    l_tar: f64,
+    options: &RemeshOptions,
+) -> Result<Option<MetricField>, PipelineError> {
+    let reference = field.reference();
+    let sized = match options.sizes.any() {
+        true => {
+            let m = apply_sizes(
+                reference,
+                field.vertex_metrics(),
+                l_tar,
+                1.0,
+                &options.sizes,
+            );
+            Some(field.with_metrics(m).map_err(PipelineError::SizedMetric)?)
+        }
+        false => None,
+    };
+    Ok(sized)
+}
+
+/// Curved feature lines refine the faces beside them (the a-priori scaling stops at
+/// creases), after the profile is chosen: a part's creases are no sign of a coarse input.
+/// Raises `fid_scale` (when there is one) to the crease scaling; the feature edges.
+fn refine_beside_features(
+    field: &MetricField,
+    topo: &Topology,
+    options: &RemeshOptions,
+    (l_tar, min_edge): (f64, f64),
+    fid_scale: &mut [f64],
+) -> Vec<crate::ids::EdgeKey> {
+    let reference = field.reference();
+    let feature_edges = options.features.edges(reference, topo);
+    if !fid_scale.is_empty() && !feature_edges.is_empty() {
+        let crease = crate::features::crease_scale(
+            reference,
+            &feature_edges,
+            field.vertex_metrics(),
+            l_tar,
+            options.fidelity.max_deviation,
+            min_edge,
+        );
+        for (f, c) in fid_scale.iter_mut().zip(crease) {
+            *f = f.max(c);
+        }
+    }
+    feature_edges
+}
+
+/// The metric with the a-priori scaling `fid_scale` applied, when there is one.
+fn scaled_metric(
+    field: &MetricField,
+    fid_scale: &[f64],
+) -> Result<Option<MetricField>, PipelineError> {
+    let scaled = if fid_scale.is_empty() {
+        None
+    } else {
+        let metrics = field
+            .vertex_metrics()
+            .iter()
+            .zip(fid_scale)
+            .map(|(m, f)| m * *f)
+            .collect();
+        Some(
+            field
+                .with_metrics(metrics)
+                .map_err(PipelineError::FidelityMetric)?,
+        )
+    };
+    Ok(scaled)
 }
 
 /// A-priori fidelity scaling (our addition, [`fidelity::a_priori_scale`]): the metric is

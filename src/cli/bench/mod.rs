@@ -232,18 +232,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = args.threads.iter().find(|n| **n == 0) {
         bail!("--threads: every thread count must be at least 1, got {n}");
     }
-    // Outputs are named by the input's file stem: two inputs with one stem would overwrite
-    // each other's output, report and log.
-    let mut stems: Vec<(String, &PathBuf)> = meshes.iter().map(|m| (stem(m), m)).collect();
-    stems.sort();
-    if let Some(w) = stems.windows(2).find(|w| w[0].0 == w[1].0) {
-        bail!(
-            "{} and {} share the name `{}` (outputs are named by it); bench them separately",
-            w[0].1.display(),
-            w[1].1.display(),
-            w[0].0
-        );
-    }
+    distinct_stems(&meshes)?;
     let mmg = tools::find_mmg(args.mmg.as_deref())?;
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;
@@ -256,58 +245,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
         mmg,
         metric: remesh_arg_value(&args.remesh_args, "--metric").map(PathBuf::from),
     };
-    // An output must not replace its input (a mesh benched from inside the output folder).
-    let out_dir = args
-        .out_dir
-        .canonicalize()
-        .with_context(|| format!("resolving {}", args.out_dir.display()))?;
-    for mesh in &meshes {
-        let input = mesh
-            .canonicalize()
-            .with_context(|| format!("reading {}", mesh.display()))?;
-        let name = stem(mesh);
-        if folder
-            .outputs(&name, mesh)
-            .iter()
-            .any(|o| input == out_dir.join(o.file_name().unwrap_or_default()))
-        {
-            bail!(
-                "{} would be overwritten by its own output; choose another --out-dir",
-                mesh.display()
-            );
-        }
-    }
+    refuse_overwriting_inputs(&folder, &meshes, &args.out_dir)?;
     let header = tools::Header::start(folder.mmg.as_deref(), timeout);
     let mut rows = Vec::new();
     for mesh in &meshes {
-        let name = stem(mesh);
-        // A stale report must not be read as this run's, nor a stale mesh stand beside a
-        // failed run.
-        for stale in folder.outputs(&name, mesh) {
-            remove_stale(&stale)?;
-        }
-        let row = folder.remesh(mesh, &name, "", folder.threads.first().copied())?;
-        eprintln!("{}", row_text(&row));
-        let mut threads = Vec::new();
-        for &n in folder.threads.iter().skip(1) {
-            let other = folder.remesh(mesh, &name, &format!("-t{n}"), Some(n))?;
-            let same = match (&row.outcome, &other.outcome) {
-                (Ok(_), Ok(_)) => Some(same_bytes(
-                    &folder.path(&name, ".obj"),
-                    &folder.path(&name, &format!("-t{n}.obj")),
-                )),
-                _ => None,
-            };
-            threads.push(ThreadRun {
-                outcome: other.outcome.map(|o| o.seconds),
-                same,
-            });
-        }
-        let pair = side_by_side::run_mesh(&folder, mesh, &name, &row)?;
-        for t in [&pair.conemesh, &pair.mmg] {
-            eprintln!("{}", tools::tool_row(&name, t, pair.time_ratio()));
-        }
-        rows.push(MeshRows { row, threads, pair });
+        rows.push(bench_mesh(&folder, mesh)?);
     }
     let header = header.end();
     let mut table = table(&rows, &folder, &header);
@@ -331,23 +273,103 @@ pub fn run(args: BenchArgs) -> anyhow::Result<ExitCode> {
     conemesh::io::write_bytes_atomic(&path, table.as_bytes())
         .with_context(|| format!("writing {}", path.display()))?;
     println!("wrote {}", path.display());
-    let failed = rows
-        .iter()
-        .filter(|r| {
-            r.row.outcome.is_err()
-                || r.threads
-                    .iter()
-                    .any(|t| t.outcome.is_err() || t.same == Some(false))
-                || [&r.pair.conemesh, &r.pair.mmg]
-                    .iter()
-                    .any(|t| matches!(t.outcome, tools::Outcome::Failed { .. }))
-        })
-        .count();
+    let failed = rows.iter().filter(|r| r.failed()).count();
     if failed > 0 {
         eprintln!("error: {failed} of {} meshes had a failed run", rows.len());
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Outputs are named by the input's file stem: two inputs with one stem would overwrite each
+/// other's output, report and log.
+fn distinct_stems(meshes: &[PathBuf]) -> anyhow::Result<()> {
+    let mut stems: Vec<(String, &PathBuf)> = meshes.iter().map(|m| (stem(m), m)).collect();
+    stems.sort();
+    if let Some(w) = stems.windows(2).find(|w| w[0].0 == w[1].0) {
+        bail!(
+            "{} and {} share the name `{}` (outputs are named by it); bench them separately",
+            w[0].1.display(),
+            w[1].1.display(),
+            w[0].0
+        );
+    }
+    Ok(())
+}
+
+/// An output must not replace its input (a mesh benched from inside the output folder).
+fn refuse_overwriting_inputs(
+    folder: &Folder,
+    meshes: &[PathBuf],
+    out_dir: &Path,
+) -> anyhow::Result<()> {
+    let out_dir = out_dir
+        .canonicalize()
+        .with_context(|| format!("resolving {}", out_dir.display()))?;
+    for mesh in meshes {
+        let input = mesh
+            .canonicalize()
+            .with_context(|| format!("reading {}", mesh.display()))?;
+        let name = stem(mesh);
+        if folder
+            .outputs(&name, mesh)
+            .iter()
+            .any(|o| input == out_dir.join(o.file_name().unwrap_or_default()))
+        {
+            bail!(
+                "{} would be overwritten by its own output; choose another --out-dir",
+                mesh.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// One mesh's runs: conemesh (again at each further thread count, compared byte for byte),
+/// then MMG beside it.
+fn bench_mesh(folder: &Folder, mesh: &Path) -> anyhow::Result<MeshRows> {
+    let name = stem(mesh);
+    // A stale report must not be read as this run's, nor a stale mesh stand beside a
+    // failed run.
+    for stale in folder.outputs(&name, mesh) {
+        remove_stale(&stale)?;
+    }
+    let row = folder.remesh(mesh, &name, "", folder.threads.first().copied())?;
+    eprintln!("{}", row_text(&row));
+    let mut threads = Vec::new();
+    for &n in folder.threads.iter().skip(1) {
+        let other = folder.remesh(mesh, &name, &format!("-t{n}"), Some(n))?;
+        let same = match (&row.outcome, &other.outcome) {
+            (Ok(_), Ok(_)) => Some(same_bytes(
+                &folder.path(&name, ".obj"),
+                &folder.path(&name, &format!("-t{n}.obj")),
+            )),
+            _ => None,
+        };
+        threads.push(ThreadRun {
+            outcome: other.outcome.map(|o| o.seconds),
+            same,
+        });
+    }
+    let pair = side_by_side::run_mesh(folder, mesh, &name, &row)?;
+    for t in [&pair.conemesh, &pair.mmg] {
+        eprintln!("{}", tools::tool_row(&name, t, pair.time_ratio()));
+    }
+    Ok(MeshRows { row, threads, pair })
+}
+
+impl MeshRows {
+    /// Whether any of the mesh's runs failed, or a thread count changed the output.
+    fn failed(&self) -> bool {
+        self.row.outcome.is_err()
+            || self
+                .threads
+                .iter()
+                .any(|t| t.outcome.is_err() || t.same == Some(false))
+            || [&self.pair.conemesh, &self.pair.mmg]
+                .iter()
+                .any(|t| matches!(t.outcome, tools::Outcome::Failed { .. }))
+    }
 }
 
 /// What every mesh's runs share.

@@ -11,9 +11,10 @@
 //! connection that ran through the removed faces is not carried by new ones), the topology
 //! is built from scratch instead: the certificates then see exactly what the build sees.
 
-use super::{vertex_face_lists, Topology, NONE};
+use super::{vertex_face_lists, ComponentInfo, Topology, NONE};
 use crate::ids::{EdgeKey, FaceId, VertexId};
 use crate::mesh::{TriMesh, UnionFind};
+use std::ops::Range;
 
 /// An undirected edge whose faces changed: one of the removed faces' edges or one of the new
 /// faces'.
@@ -35,6 +36,36 @@ impl Changed {
     fn count(&self) -> usize {
         self.kept.len() + self.new.len()
     }
+}
+
+/// The kept faces' renumbering: the removed faces dropped, the others keeping their order.
+struct Renumbering {
+    /// Whether each old face is removed.
+    gone: Vec<bool>,
+    /// Old face → new face; `NONE` for removed faces.
+    fmap: Vec<u32>,
+    /// The new faces (appended after the kept ones).
+    new_faces: Range<usize>,
+    /// The component of the removed faces (they all lie in one).
+    c0: u32,
+}
+
+/// The edge list after the update, and where the old and the changed edges went in it.
+struct MergedEdges {
+    edges: Vec<EdgeKey>,
+    edge_face_count: Vec<u32>,
+    /// Old edge → new edge; `NONE` for edges no face uses any more.
+    remap: Vec<u32>,
+    /// Changed edge → new edge; `NONE` for edges no face uses any more.
+    index_of_changed: Vec<u32>,
+}
+
+/// The half-edge fields after the update.
+struct PairedHalfedges {
+    halfedge_edge: Vec<u32>,
+    opposite: Vec<u32>,
+    non_manifold_edges: Vec<(EdgeKey, usize)>,
+    inconsistent_edges: Vec<EdgeKey>,
 }
 
 impl Topology {
@@ -73,6 +104,51 @@ impl Topology {
 
     /// The update, or `None` when it must be built from scratch (see the module docs).
     fn updated(&self, mesh: &TriMesh, removed: &[FaceId]) -> Option<Topology> {
+        let faces = self.renumbering(mesh, removed)?;
+        let changed = self.changed_edges(mesh, removed, &faces);
+        if !components_unchanged(&changed, faces.new_faces.clone()) {
+            return None;
+        }
+        let merged = self.merged_edges(&changed, faces.new_faces.len());
+        let paired = self.paired_halfedges(mesh, &faces, &changed, &merged);
+        let (vf_offsets, vf_faces) = vertex_face_lists(mesh);
+        let (face_component, components) =
+            self.components_after(mesh, removed, &faces, &changed, (&vf_offsets, &vf_faces))?;
+
+        let boundary_changed = changed.iter().any(|c| {
+            c.count() == 1 || c.old.is_some_and(|e| self.edge_face_count[e as usize] == 1)
+        });
+        let mut topo = Topology {
+            triangles: mesh.triangles.clone(),
+            n_vertices: mesh.n_vertices(),
+            opposite: paired.opposite,
+            halfedge_edge: paired.halfedge_edge,
+            edges: merged.edges,
+            edge_face_count: merged.edge_face_count,
+            vf_offsets,
+            vf_faces,
+            face_component,
+            components,
+            boundary_loops: Vec::new(),
+            boundary_loop_component: Vec::new(),
+            non_manifold_edges: paired.non_manifold_edges,
+            inconsistent_edges: paired.inconsistent_edges,
+            non_manifold_vertices: std::sync::OnceLock::new(),
+        };
+        // Untouched boundary half-edges keep their order under the face map, so the loops
+        // (traced from the first unused one) come out the same.
+        topo.boundary_loops = match boundary_changed {
+            true => topo.trace_boundary_loops(),
+            false => self.boundary_loops.clone(),
+        };
+        topo.boundary_loop_component = topo.loop_components();
+        topo.recount_loops_and_genus();
+        Some(topo)
+    }
+
+    /// The kept faces' renumbering, or `None` when the new mesh is not this one with
+    /// `removed` dropped and faces appended, or the removed faces span two components.
+    fn renumbering(&self, mesh: &TriMesh, removed: &[FaceId]) -> Option<Renumbering> {
         let old_nf = self.triangles.len();
         let mut gone = vec![false; old_nf];
         for f in removed {
@@ -98,16 +174,32 @@ impl Topology {
                 next += 1;
             }
         }
-        let key_of = |t: &[VertexId; 3], i: usize| EdgeKey::new(t[i], t[(i + 1) % 3]);
         let c0 = self.face_component[removed[0].idx()];
         if removed.iter().any(|f| self.face_component[f.idx()] != c0) {
             return None;
         }
+        Some(Renumbering {
+            gone,
+            fmap,
+            new_faces: kept_faces..nf,
+            c0,
+        })
+    }
 
-        // The new faces' half-edges by edge, and the changed edges.
-        let mut new_he: Vec<(EdgeKey, u32)> = (kept_faces..nf)
+    /// Every edge of a removed or a new face, in key order, with its kept, removed and new
+    /// half-edges.
+    fn changed_edges(
+        &self,
+        mesh: &TriMesh,
+        removed: &[FaceId],
+        faces: &Renumbering,
+    ) -> Vec<Changed> {
+        // The new faces' half-edges by edge.
+        let mut new_he: Vec<(EdgeKey, u32)> = faces
+            .new_faces
+            .clone()
             .flat_map(|f| (0..3).map(move |i| (f, i)))
-            .map(|(f, i)| (key_of(&mesh.triangles[f], i), (3 * f + i) as u32))
+            .map(|(f, i)| (edge_key(&mesh.triangles[f], i), (3 * f + i) as u32))
             .collect();
         new_he.sort_unstable();
         let mut old_keys: Vec<u32> = removed
@@ -161,45 +253,27 @@ impl Topology {
         for c in changed.iter_mut().filter(|c| c.old.is_some()) {
             for &f in self.vertex_faces(c.key.0) {
                 for i in 0..3 {
-                    if key_of(&self.triangles[f.idx()], i) != c.key {
+                    if edge_key(&self.triangles[f.idx()], i) != c.key {
                         continue;
                     }
-                    match gone[f.idx()] {
+                    match faces.gone[f.idx()] {
                         true => c.removed += 1,
                         false => {
-                            c.kept.push(3 * fmap[f.idx()] + i as u32);
-                            c.kept_elsewhere |= self.face_component[f.idx()] != c0;
+                            c.kept.push(3 * faces.fmap[f.idx()] + i as u32);
+                            c.kept_elsewhere |= self.face_component[f.idx()] != faces.c0;
                         }
                     }
                 }
             }
             c.kept.sort_unstable();
         }
+        changed
+    }
 
-        // The components stay as they were when the new faces are edge-connected, every edge
-        // that joined a kept face to a removed one joins it to a new one, and the new faces
-        // touch no other component.
-        let mut sets = UnionFind::new(nf - kept_faces);
-        for c in &changed {
-            if c.removed > 0 && !c.kept.is_empty() && c.new.is_empty() {
-                return None;
-            }
-            if !c.new.is_empty() && c.kept_elsewhere {
-                return None;
-            }
-            for h in c.new.iter().skip(1) {
-                sets.union(
-                    (c.new[0] / 3) as usize - kept_faces,
-                    (*h / 3) as usize - kept_faces,
-                );
-            }
-        }
-        if sets.count() != 1 {
-            return None;
-        }
-
-        // Edges: the old ones still in use, merged with the new ones, in key order.
-        let mut edges = Vec::with_capacity(self.edges.len() + new_he.len() / 2);
+    /// The edges after the update: the old ones still in use merged with the new ones, in
+    /// key order.
+    fn merged_edges(&self, changed: &[Changed], n_new_faces: usize) -> MergedEdges {
+        let mut edges = Vec::with_capacity(self.edges.len() + 3 * n_new_faces / 2);
         let mut edge_face_count = Vec::with_capacity(edges.capacity());
         let mut remap = vec![NONE; self.edges.len()];
         let mut index_of_changed = vec![NONE; changed.len()];
@@ -228,23 +302,37 @@ impl Topology {
                 e += 1;
             }
         }
+        MergedEdges {
+            edges,
+            edge_face_count,
+            remap,
+            index_of_changed,
+        }
+    }
 
-        // Half-edges: carried over through the face map, then the changed edges paired again
-        // by the build's rule.
-        let nh = 3 * nf;
+    /// The half-edges after the update: carried over through the face map, then the changed
+    /// edges paired again by the build's rule.
+    fn paired_halfedges(
+        &self,
+        mesh: &TriMesh,
+        faces: &Renumbering,
+        changed: &[Changed],
+        merged: &MergedEdges,
+    ) -> PairedHalfedges {
+        let nh = 3 * mesh.n_faces();
         let mut halfedge_edge = vec![NONE; nh];
         let mut opposite = vec![NONE; nh];
-        for f in 0..old_nf {
-            if gone[f] {
+        for f in 0..self.triangles.len() {
+            if faces.gone[f] {
                 continue;
             }
-            let g = fmap[f] as usize;
+            let g = faces.fmap[f] as usize;
             for i in 0..3 {
                 let e = self.halfedge_edge[3 * f + i] as usize;
-                halfedge_edge[3 * g + i] = remap[e];
+                halfedge_edge[3 * g + i] = merged.remap[e];
                 let o = self.opposite[3 * f + i];
                 if o != NONE {
-                    let of = fmap[(o / 3) as usize];
+                    let of = faces.fmap[(o / 3) as usize];
                     if of != NONE {
                         opposite[3 * g + i] = 3 * of + o % 3;
                     }
@@ -255,7 +343,7 @@ impl Topology {
         let mut non_manifold_edges: Vec<(EdgeKey, usize)> = Vec::new();
         let mut inconsistent_edges: Vec<EdgeKey> = Vec::new();
         let mut hs: Vec<u32> = Vec::new();
-        for (c, &index) in changed.iter().zip(&index_of_changed) {
+        for (c, &index) in changed.iter().zip(&merged.index_of_changed) {
             hs.clear();
             hs.extend(c.kept.iter().chain(&c.new));
             hs.sort_unstable();
@@ -286,21 +374,38 @@ impl Topology {
         non_manifold_edges.sort_unstable();
         inconsistent_edges.extend(self.inconsistent_edges.iter().filter(|k| !is_changed(k)));
         inconsistent_edges.sort_unstable();
+        PairedHalfedges {
+            halfedge_edge,
+            opposite,
+            non_manifold_edges,
+            inconsistent_edges,
+        }
+    }
 
-        let (vf_offsets, vf_faces) = vertex_face_lists(mesh);
-
-        // Components: the new faces join the removed faces' one; labels in order of first face.
+    /// The face labels and component summaries after the update: the new faces join the
+    /// removed faces' component, whose counts change by what came and went; labels are
+    /// renumbered in order of first face. `None` when a component emptied (the labels would
+    /// not match the build's).
+    fn components_after(
+        &self,
+        mesh: &TriMesh,
+        removed: &[FaceId],
+        faces: &Renumbering,
+        changed: &[Changed],
+        (vf_offsets, vf_faces): (&[u32], &[FaceId]),
+    ) -> Option<(Vec<u32>, Vec<ComponentInfo>)> {
+        let (nf, c0) = (mesh.n_faces(), faces.c0);
         let mut face_component: Vec<u32> = Vec::with_capacity(nf);
         face_component.extend(
-            (0..old_nf)
-                .filter(|&f| !gone[f])
+            (0..self.triangles.len())
+                .filter(|&f| !faces.gone[f])
                 .map(|f| self.face_component[f]),
         );
         face_component.resize(nf, c0);
         let mut components = self.components.clone();
         {
             let info = &mut components[c0 as usize];
-            info.faces = info.faces + (nf - kept_faces) - removed.len();
+            info.faces = info.faces + faces.new_faces.len() - removed.len();
             let born = changed
                 .iter()
                 .filter(|c| c.old.is_none() && c.count() > 0)
@@ -313,7 +418,7 @@ impl Topology {
             let mut touched: Vec<VertexId> = removed
                 .iter()
                 .flat_map(|f| self.triangles[f.idx()])
-                .chain((kept_faces..nf).flat_map(|f| mesh.triangles[f]))
+                .chain(faces.new_faces.clone().flat_map(|f| mesh.triangles[f]))
                 .collect();
             touched.sort_unstable();
             touched.dedup();
@@ -355,37 +460,33 @@ impl Topology {
         for (l, info) in components.into_iter().enumerate() {
             ordered[relabel[l] as usize] = info;
         }
-
-        let boundary_changed = changed.iter().any(|c| {
-            c.count() == 1 || c.old.is_some_and(|e| self.edge_face_count[e as usize] == 1)
-        });
-        let mut topo = Topology {
-            triangles: mesh.triangles.clone(),
-            n_vertices: mesh.n_vertices(),
-            opposite,
-            halfedge_edge,
-            edges,
-            edge_face_count,
-            vf_offsets,
-            vf_faces,
-            face_component,
-            components: ordered,
-            boundary_loops: Vec::new(),
-            boundary_loop_component: Vec::new(),
-            non_manifold_edges,
-            inconsistent_edges,
-            non_manifold_vertices: std::sync::OnceLock::new(),
-        };
-        // Untouched boundary half-edges keep their order under the face map, so the loops
-        // (traced from the first unused one) come out the same.
-        topo.boundary_loops = match boundary_changed {
-            true => topo.trace_boundary_loops(),
-            false => self.boundary_loops.clone(),
-        };
-        topo.boundary_loop_component = topo.loop_components();
-        topo.recount_loops_and_genus();
-        Some(topo)
+        Some((face_component, ordered))
     }
+}
+
+/// The undirected edge of half-edge `i` of triangle `t`.
+fn edge_key(t: &[VertexId; 3], i: usize) -> EdgeKey {
+    EdgeKey::new(t[i], t[(i + 1) % 3])
+}
+
+/// The components stay as they were when the new faces are edge-connected, every edge that
+/// joined a kept face to a removed one joins it to a new one, and the new faces touch no
+/// other component.
+fn components_unchanged(changed: &[Changed], new_faces: Range<usize>) -> bool {
+    let first = new_faces.start;
+    let mut sets = UnionFind::new(new_faces.len());
+    for c in changed {
+        if c.removed > 0 && !c.kept.is_empty() && c.new.is_empty() {
+            return false;
+        }
+        if !c.new.is_empty() && c.kept_elsewhere {
+            return false;
+        }
+        for h in c.new.iter().skip(1) {
+            sets.union((c.new[0] / 3) as usize - first, (*h / 3) as usize - first);
+        }
+    }
+    sets.count() == 1
 }
 
 #[cfg(test)]

@@ -17,9 +17,9 @@
 //! `orient2d`). Boundary and constrained vertices and edges never change.
 //!
 //! Two additions to plain LCT (paper-notes.md, "LCT remeshing"), both switchable: valence flips
-//! after split/collapse, and a final polish (equilateral-apex smoothing + max-min flips). Plain
-//! LCT stalls at valence defects (q_avg ≈ 0.88–0.91 on the demo); with them every demo case has
-//! q_avg ≥ 0.91.
+//! after split/collapse, and a final polish (equilateral-apex smoothing + max-min flips); they
+//! take the mesh past the valence defects where plain LCT stalls (the measurements:
+//! notes/doc-comments.md).
 
 use super::{clamp_spd, Metric2d, PlanarDomain, PlanarMesh, PlanarRemesher, Remesh2dError};
 use crate::invariants::certify_planar;
@@ -58,8 +58,8 @@ pub struct LctOptions {
     /// Final polish passes after the last round: equilateral-apex smoothing + flips (default 6).
     pub final_smoothing: usize,
     /// `M_T` is the metric sampled at the triangle's centroid (and edge lengths use the metric at
-    /// the edge midpoint) instead of the mean of the vertex tensors (default false: as good on
-    /// the demo cases, and cheaper with a [`super::PlanarMetricField`]).
+    /// the edge midpoint) instead of the mean of the vertex tensors (default false: the mean
+    /// needs no metric evaluation, which costs more with a [`super::PlanarMetricField`]).
     pub tensor_at_centroid: bool,
     /// In the final passes, flip by the max-min metric quality criterion instead of the
     /// energy (default true).
@@ -107,9 +107,9 @@ pub const MAX_OVERSHOOT: f64 = 4.0;
 pub const MIN_TRANSIENT_BASE: f64 = 1000.0;
 
 impl Default for LctOptions {
-    /// The settings for the curvature metric at L_tar = 1.5·L_avg (the paper's protocol, measured
-    /// on the 12 shared meshes): start from the patch's own triangulation, split above 4/3 L,
-    /// collapse below 4/5 L, no density control.
+    /// The settings for the curvature metric at L_tar = 1.5·L_avg (the paper's protocol): start
+    /// from the patch's own triangulation, split above 4/3 L, collapse below 4/5 L, no density
+    /// control.
     fn default() -> Self {
         LctOptions {
             rounds: 8,
