@@ -147,7 +147,9 @@ pub enum BrokenPromise {
         first: Option<VertexId>,
     },
     /// The seed face is not a face of the patch, or does not hold the seed vertex.
-    #[error("patch {patch}: its seed face {face} (with seed vertex {vertex}) is not one of its faces")]
+    #[error(
+        "patch {patch}: its seed face {face} (with seed vertex {vertex}) is not one of its faces"
+    )]
     SeedOutside {
         /// the patch's number in the run
         patch: usize,
@@ -247,12 +249,10 @@ pub fn improver(
 ) -> Result<ImproverCounts, ContractViolation> {
     let name = improver.name();
     let broken = |promise: BrokenPromise| ContractViolation::Broken { name, promise };
-    improver
-        .validate()
-        .map_err(|e| ContractViolation::Failed {
-            name,
-            source: StageFailure::Options(e),
-        })?;
+    improver.validate().map_err(|e| ContractViolation::Failed {
+        name,
+        source: StageFailure::Options(e),
+    })?;
     let remesher = Remesher::new(RemeshOptions {
         seed: case.seed,
         ..RemeshOptions::default()
@@ -337,7 +337,9 @@ pub fn patch_strategy(
         let got = strategy.next_patch(&ctx, &mut rng).map_err(failed)?;
         let twin = strategy.next_patch(&ctx, &mut again).map_err(failed)?;
         if got != twin {
-            return Err(broken(BrokenPromise::PatchNotDeterministic { patch: patches }));
+            return Err(broken(BrokenPromise::PatchNotDeterministic {
+                patch: patches,
+            }));
         }
         let Some(patch) = got else {
             return match unprocessed {

@@ -168,10 +168,14 @@ impl Improver for WorstFirst {
         "worst-first"
     }
 
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), conemesh::option_error::OptionError> {
         match self.q > 0.0 && self.q <= 1.0 {
             true => Ok(()),
-            false => Err(format!("q must be in (0, 1], got {}", self.q)),
+            false => Err(conemesh::option_error::OptionError::OutOfRange {
+                option: "q",
+                value: self.q,
+                range: "in (0, 1]",
+            }),
         }
     }
 

@@ -3,8 +3,8 @@
 
 use conemesh::mesh::generators;
 use conemesh::metric::{
-    curvature_metric, principal_curvatures, CurvatureOptions, MetricError, MetricField, SpdDefect,
-    MetricOptions, Normalization,
+    curvature_metric, principal_curvatures, CurvatureOptions, MetricError, MetricField,
+    MetricOptions, Normalization, SpdDefect,
 };
 use conemesh::{FaceId, SurfaceLocation, TriMesh};
 use nalgebra::{Matrix3, Point3, Vector3};

@@ -124,13 +124,11 @@ pub fn parse_seeds(spec: &str) -> Result<Vec<u64>, CompareError> {
         defect,
     };
     let num = |s: &str| {
-        s.trim()
-            .parse::<u64>()
-            .map_err(|_| {
-                bad(SeedsDefect::NotASeed {
-                    part: s.trim().to_string(),
-                })
+        s.trim().parse::<u64>().map_err(|_| {
+            bad(SeedsDefect::NotASeed {
+                part: s.trim().to_string(),
             })
+        })
     };
     let mut seeds = Vec::new();
     for part in spec.split(',') {

@@ -155,8 +155,7 @@ impl Snapshot {
             defect,
         };
         let config = |e: CompareError| bad(SnapshotDefect::Config(Box::new(e)));
-        let text =
-            std::fs::read_to_string(path).map_err(|e| bad(SnapshotDefect::Unreadable(e)))?;
+        let text = std::fs::read_to_string(path).map_err(|e| bad(SnapshotDefect::Unreadable(e)))?;
         let s: Snapshot =
             serde_json::from_str(&text).map_err(|e| bad(SnapshotDefect::NotJson(e)))?;
         if s.format != FORMAT {

@@ -372,16 +372,14 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
                     });
                 };
                 last_line = l;
-                let x = t
-                    .parse::<f64>()
-                    .map_err(|_| {
-                        parse_err(
-                            l,
-                            SolSyntax::NotANumber {
-                                found: t.to_string(),
-                            },
-                        )
-                    })?;
+                let x = t.parse::<f64>().map_err(|_| {
+                    parse_err(
+                        l,
+                        SolSyntax::NotANumber {
+                            found: t.to_string(),
+                        },
+                    )
+                })?;
                 values.push(x);
             }
             sol = Some(RawSol {
@@ -392,10 +390,7 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
         } else if tok.eq_ignore_ascii_case("End") {
             break;
         } else {
-            return Err(parse_err(
-                line,
-                SolSyntax::UnexpectedToken(tok.to_string()),
-            ));
+            return Err(parse_err(line, SolSyntax::UnexpectedToken(tok.to_string())));
         }
     }
     sol.ok_or_else(|| SolError::Truncated {

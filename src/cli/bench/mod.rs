@@ -20,12 +20,12 @@ mod side_by_side;
 mod tools;
 
 use anyhow::{bail, ensure, Context};
-use std::rc::Rc;
-use tools::{FieldError, ToolError};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
+use std::rc::Rc;
 use std::time::Duration;
+use tools::{FieldError, ToolError};
 
 /// The extensions `conemesh` reads (see `conemesh::io`).
 const MESH_EXTENSIONS: [&str; 5] = ["obj", "off", "ply", "stl", "mesh"];

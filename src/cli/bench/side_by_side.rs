@@ -117,12 +117,7 @@ fn write_log(path: &Path, log: &[u8]) -> anyhow::Result<()> {
 
 /// MMG's input: `mesh` itself when it is a `.mesh`, else `conemesh convert MESH NAME.mesh`
 /// (the same vertices in the same order, so `NAME-input.sol` has one tensor per vertex).
-fn mmg_input(
-    f: &Folder,
-    mesh: &Path,
-    name: &str,
-    log: &mut Vec<u8>,
-) -> Result<PathBuf, ToolError> {
+fn mmg_input(f: &Folder, mesh: &Path, name: &str, log: &mut Vec<u8>) -> Result<PathBuf, ToolError> {
     if !needs_conversion(mesh) {
         return Ok(mesh.to_path_buf());
     }
