@@ -9,14 +9,14 @@
 //! the trait's documentation with the exact certificates of [`crate::invariants`], and
 //! returns the first broken promise, naming the elements.
 
-use crate::ids::{EdgeKey, FaceId};
+use crate::ids::{EdgeKey, FaceId, VertexId};
 use crate::improve::{Improver, ImproverCounts};
 use crate::invariants::{self, InvariantError};
 use crate::mesh::{PlanarDomain, Topology, TriMesh};
 use crate::param::Parameterizer;
 use crate::patches::{interior_corner, interior_feature, PatchContext, PatchStrategy};
 use crate::pipeline::{RemeshOptions, Remesher, Stages};
-use crate::registry::{Entry, MetricSizes, Params, Stage};
+use crate::registry::{Entry, MetricSizes, Params, RegistryError, Stage};
 use crate::remesh2d::{Metric2d, PlanarRemesher};
 use crate::Rng;
 use rand::SeedableRng;
@@ -24,15 +24,15 @@ use std::collections::HashSet;
 use thiserror::Error;
 
 /// A broken promise of an extension point.
-#[derive(Debug, Error, Clone, PartialEq)]
+#[derive(Debug, Error)]
 pub enum ContractViolation {
     /// The implementation returned an error where it must succeed.
-    #[error("`{name}` failed: {message}")]
+    #[error("`{name}` failed: {source}")]
     Failed {
         /// the implementation
         name: &'static str,
         /// its error
-        message: String,
+        source: StageFailure,
     },
     /// A certificate of the result failed.
     #[error("`{name}`: {what}: {violation}")]
@@ -45,13 +45,161 @@ pub enum ContractViolation {
         violation: InvariantError,
     },
     /// Any other broken promise.
-    #[error("`{name}`: {message}")]
+    #[error("`{name}`: {promise}")]
     Broken {
         /// the implementation
         name: &'static str,
         /// what was promised and what happened
-        message: String,
+        promise: BrokenPromise,
     },
+}
+
+/// The error of an implementation that failed where it must succeed
+/// ([`ContractViolation::Failed`]), as its stage gave it.
+#[derive(Debug, Error)]
+pub enum StageFailure {
+    /// The registry row does not build with its defaults.
+    #[error("{0}")]
+    Build(#[source] RegistryError),
+    /// The registry row refuses an option given its documented default.
+    #[error("its documented default, for {sizes:?} sizes: {source}")]
+    Default {
+        /// the kind of sizes it was built for
+        sizes: MetricSizes,
+        /// the registry's error
+        source: RegistryError,
+    },
+    /// The improver's options do not validate.
+    #[error("its options do not validate: {0}")]
+    Options(#[source] crate::option_error::OptionError),
+    /// The run with the improver failed.
+    #[error("{0}")]
+    Run(#[source] Box<crate::pipeline::PipelineError>),
+    /// The patch strategy failed.
+    #[error("{0}")]
+    Patch(#[source] crate::patches::PatchError),
+    /// The parameterizer failed.
+    #[error("{0}")]
+    Param(#[source] crate::param::ParamError),
+    /// The planar remesher failed.
+    #[error("{0}")]
+    Remesh2d(#[source] crate::remesh2d::Remesh2dError),
+}
+
+/// A promise of an extension point's documentation that a result breaks
+/// ([`ContractViolation::Broken`]), with the elements and counts that show it.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum BrokenPromise {
+    /// A registry row lists an option twice.
+    #[error("option `{option}` is listed twice")]
+    OptionTwice {
+        /// the option
+        option: &'static str,
+    },
+    /// The run with an improver has no improvement report.
+    #[error("the run has no improvement report")]
+    NoImprovementReport,
+    /// The run with one improver reports another number of steps.
+    #[error("{0} improvement steps for one improver")]
+    ImprovementSteps(usize),
+    /// The improver's step is under another name.
+    #[error("its step is named `{step}`")]
+    StepName {
+        /// the step's name
+        step: String,
+    },
+    /// The same seed gave a different mesh.
+    #[error("the same seed gave a different mesh")]
+    NotDeterministic,
+    /// The same seed gave a different patch.
+    #[error("patch {patch}: the same seed gave a different patch")]
+    PatchNotDeterministic {
+        /// the patch's number in the run
+        patch: usize,
+    },
+    /// No patch while faces are unprocessed.
+    #[error("returned no patch with {unprocessed} faces unprocessed")]
+    NoPatch {
+        /// the unprocessed faces
+        unprocessed: usize,
+    },
+    /// A patch when every face is processed.
+    #[error("returned a patch with every face processed")]
+    PatchWhenDone,
+    /// More patches than faces.
+    #[error("{patches} patches for {faces} faces")]
+    TooManyPatches {
+        /// patches returned
+        patches: usize,
+        /// faces of the mesh
+        faces: usize,
+    },
+    /// The returned boundary is not the certified loop of the patch's faces.
+    #[error(
+        "patch {patch}: the returned boundary ({len} vertices from {first:?}) is not the certified loop of its faces"
+    )]
+    WrongBoundary {
+        /// the patch's number in the run
+        patch: usize,
+        /// the returned boundary's length
+        len: usize,
+        /// its first vertex
+        first: Option<VertexId>,
+    },
+    /// The seed face is not a face of the patch, or does not hold the seed vertex.
+    #[error(
+        "patch {patch}: its seed face {face} (with seed vertex {vertex}) is not one of its faces"
+    )]
+    SeedOutside {
+        /// the patch's number in the run
+        patch: usize,
+        /// the seed face
+        face: FaceId,
+        /// the seed vertex
+        vertex: VertexId,
+    },
+    /// `shrink` did not give a smaller part of the patch.
+    #[error("patch {patch}: shrink to {target} gave {got} faces, not a smaller part of the patch")]
+    BadShrink {
+        /// the patch's number in the run
+        patch: usize,
+        /// the faces asked for
+        target: usize,
+        /// the faces given
+        got: usize,
+    },
+    /// A face outside the mesh.
+    #[error("face {0} is not in the mesh")]
+    FaceOutside(FaceId),
+    /// Faces not sorted by id, or repeated.
+    #[error("faces are not sorted by id without repeats")]
+    Unsorted,
+    /// A patch of processed faces only.
+    #[error("a patch without an unprocessed face")]
+    AllProcessed,
+    /// A corner vertex inside a patch.
+    #[error("the corner vertex {0} is inside a patch")]
+    CornerInside(VertexId),
+    /// A feature edge inside a patch.
+    #[error("the feature edge {0} is inside a patch")]
+    FeatureInside(EdgeKey),
+    /// Another number of points than vertices.
+    #[error("{points} points for {vertices} vertices")]
+    PointCount {
+        /// points returned
+        points: usize,
+        /// vertices of the mesh
+        vertices: usize,
+    },
+    /// A point that is not finite.
+    #[error("the point of {0} is not finite")]
+    NonFinitePoint(VertexId),
+    /// A second call gave a different map.
+    #[error("a second call gave a different map")]
+    DifferentMap,
+    /// A map of a mesh that is not a disk.
+    #[error("returned a map of a mesh that is not a disk (face {0} removed)")]
+    MappedNonDisk(FaceId),
 }
 
 /// The contract of a registry row: for either kind of sizes it builds with its defaults, the
@@ -59,24 +207,24 @@ pub enum ContractViolation {
 /// every option given its documented default explicitly (`KEY=DEFAULT`) is taken.
 pub fn registry_row<T: ?Sized + Stage>(row: &Entry<T>) -> Result<(), ContractViolation> {
     let name = row.name;
-    let failed = |message: String| ContractViolation::Failed { name, message };
+    let failed = |source: StageFailure| ContractViolation::Failed { name, source };
     let table = std::slice::from_ref(row);
     for (i, o) in row.options.iter().enumerate() {
         if row.options[..i].iter().any(|p| p.name == o.name) {
             return Err(ContractViolation::Broken {
                 name,
-                message: format!("option `{}` is listed twice", o.name),
+                promise: BrokenPromise::OptionTwice { option: o.name },
             });
         }
     }
     for sizes in MetricSizes::ALL {
         crate::registry::build(table, name, Params::default(), sizes)
-            .map_err(|e| failed(e.to_string()))?;
+            .map_err(|e| failed(StageFailure::Build(e)))?;
         for o in row.options {
             let mut given = Params::default();
             given.set(o.name, (o.default)(sizes));
             crate::registry::build(table, name, given, sizes)
-                .map_err(|e| failed(format!("its documented default, for {sizes:?} sizes: {e}")))?;
+                .map_err(|source| failed(StageFailure::Default { sizes, source }))?;
         }
     }
     Ok(())
@@ -100,13 +248,11 @@ pub fn improver(
     case: &ImproverCase<'_>,
 ) -> Result<ImproverCounts, ContractViolation> {
     let name = improver.name();
-    let broken = |message: String| ContractViolation::Broken { name, message };
-    improver
-        .validate()
-        .map_err(|message| ContractViolation::Failed {
-            name,
-            message: format!("its options do not validate: {message}"),
-        })?;
+    let broken = |promise: BrokenPromise| ContractViolation::Broken { name, promise };
+    improver.validate().map_err(|e| ContractViolation::Failed {
+        name,
+        source: StageFailure::Options(e),
+    })?;
     let remesher = Remesher::new(RemeshOptions {
         seed: case.seed,
         ..RemeshOptions::default()
@@ -120,25 +266,24 @@ pub fn improver(
             .run(case.mesh)
             .map_err(|e| ContractViolation::Failed {
                 name,
-                message: e.to_string(),
+                source: StageFailure::Run(Box::new(e)),
             })
     };
     let out = run()?;
     let Some(report) = &out.unit.report.improvement else {
-        return Err(broken("the run has no improvement report".into()));
+        return Err(broken(BrokenPromise::NoImprovementReport));
     };
     let [step] = report.steps.as_slice() else {
-        return Err(broken(format!(
-            "{} improvement steps for one improver",
-            report.steps.len()
-        )));
+        return Err(broken(BrokenPromise::ImprovementSteps(report.steps.len())));
     };
     if step.name != name {
-        return Err(broken(format!("its step is named `{}`", step.name)));
+        return Err(broken(BrokenPromise::StepName {
+            step: step.name.to_string(),
+        }));
     }
     let again = run()?;
     if again.mesh.positions != out.mesh.positions || again.mesh.triangles != out.mesh.triangles {
-        return Err(broken("the same seed gave a different mesh".into()));
+        return Err(broken(BrokenPromise::NotDeterministic));
     }
     Ok(step.counts)
 }
@@ -170,7 +315,7 @@ pub fn patch_strategy(
     case: &StrategyCase<'_>,
 ) -> Result<usize, ContractViolation> {
     let name = strategy.name();
-    let broken = |message: String| ContractViolation::Broken { name, message };
+    let broken = |promise: BrokenPromise| ContractViolation::Broken { name, promise };
     let topo = Topology::build(case.mesh);
     let mut processed = case.processed.clone();
     let (mut rng, mut again) = (Rng::seed_from_u64(case.seed), Rng::seed_from_u64(case.seed));
@@ -187,57 +332,57 @@ pub fn patch_strategy(
         let unprocessed = processed.iter().filter(|p| !**p).count();
         let failed = |e: crate::patches::PatchError| ContractViolation::Failed {
             name,
-            message: e.to_string(),
+            source: StageFailure::Patch(e),
         };
         let got = strategy.next_patch(&ctx, &mut rng).map_err(failed)?;
         let twin = strategy.next_patch(&ctx, &mut again).map_err(failed)?;
         if got != twin {
-            return Err(broken(format!(
-                "patch {patches}: the same seed gave a different patch"
-            )));
+            return Err(broken(BrokenPromise::PatchNotDeterministic {
+                patch: patches,
+            }));
         }
         let Some(patch) = got else {
             return match unprocessed {
                 0 => Ok(patches),
-                n => Err(broken(format!(
-                    "returned no patch with {n} faces unprocessed"
-                ))),
+                unprocessed => Err(broken(BrokenPromise::NoPatch { unprocessed })),
             };
         };
         if unprocessed == 0 {
-            return Err(broken("returned a patch with every face processed".into()));
+            return Err(broken(BrokenPromise::PatchWhenDone));
         }
         if patches > case.mesh.n_faces() {
-            return Err(broken(format!(
-                "{patches} patches for {} faces",
-                case.mesh.n_faces()
-            )));
+            return Err(broken(BrokenPromise::TooManyPatches {
+                patches,
+                faces: case.mesh.n_faces(),
+            }));
         }
         let boundary = check_patch_faces(name, &ctx, &patch.faces)?;
         if !same_loop(&boundary, &patch.boundary) {
-            return Err(broken(format!(
-                "patch {patches}: the returned boundary ({} vertices from {:?}) is not the certified loop of its faces",
-                patch.boundary.len(),
-                patch.boundary.first()
-            )));
+            return Err(broken(BrokenPromise::WrongBoundary {
+                patch: patches,
+                len: patch.boundary.len(),
+                first: patch.boundary.first().copied(),
+            }));
         }
         if patch.faces.binary_search(&patch.seed_face).is_err()
             || !case.mesh.face(patch.seed_face).contains(&patch.seed_vertex)
         {
-            return Err(broken(format!(
-                "patch {patches}: its seed face {} (with seed vertex {}) is not one of its faces",
-                patch.seed_face, patch.seed_vertex
-            )));
+            return Err(broken(BrokenPromise::SeedOutside {
+                patch: patches,
+                face: patch.seed_face,
+                vertex: patch.seed_vertex,
+            }));
         }
         if patch.faces.len() > 1 {
             let target = patch.faces.len() / 2;
             let smaller = strategy.shrink(&ctx, &patch.faces, patch.seed_face, target);
             let inside: HashSet<FaceId> = patch.faces.iter().copied().collect();
             if smaller.len() >= patch.faces.len() || smaller.iter().any(|f| !inside.contains(f)) {
-                return Err(broken(format!(
-                    "patch {patches}: shrink to {target} gave {} faces, not a smaller part of the patch",
-                    smaller.len()
-                )));
+                return Err(broken(BrokenPromise::BadShrink {
+                    patch: patches,
+                    target,
+                    got: smaller.len(),
+                }));
             }
             let mut sorted = smaller.clone();
             sorted.sort_unstable();
@@ -257,15 +402,15 @@ fn check_patch_faces(
     ctx: &PatchContext<'_>,
     faces: &[FaceId],
 ) -> Result<Vec<crate::ids::VertexId>, ContractViolation> {
-    let broken = |message: String| ContractViolation::Broken { name, message };
+    let broken = |promise: BrokenPromise| ContractViolation::Broken { name, promise };
     if let Some(f) = faces.iter().find(|f| f.idx() >= ctx.mesh.n_faces()) {
-        return Err(broken(format!("face {f} is not in the mesh")));
+        return Err(broken(BrokenPromise::FaceOutside(*f)));
     }
     if faces.windows(2).any(|w| w[0] >= w[1]) {
-        return Err(broken("faces are not sorted by id without repeats".into()));
+        return Err(broken(BrokenPromise::Unsorted));
     }
     if faces.iter().all(|f| ctx.processed[f.idx()]) {
-        return Err(broken("a patch without an unprocessed face".into()));
+        return Err(broken(BrokenPromise::AllProcessed));
     }
     let boundary = invariants::certify_disk(ctx.mesh, faces).map_err(|violation| {
         ContractViolation::Certificate {
@@ -278,13 +423,13 @@ fn check_patch_faces(
         .corners
         .and_then(|c| interior_corner(ctx.mesh, ctx.topology, faces, c))
     {
-        return Err(broken(format!("the corner vertex {v} is inside a patch")));
+        return Err(broken(BrokenPromise::CornerInside(v)));
     }
     if let Some(e) = ctx
         .feature_edges
         .and_then(|fe| interior_feature(ctx.mesh, faces, fe))
     {
-        return Err(broken(format!("the feature edge {e} is inside a patch")));
+        return Err(broken(BrokenPromise::FeatureInside(e)));
     }
     Ok(boundary)
 }
@@ -309,26 +454,25 @@ pub fn parameterizer(
     boundary: &[crate::ids::VertexId],
 ) -> Result<(), ContractViolation> {
     let name = param.name();
-    let broken = |message: String| ContractViolation::Broken { name, message };
+    let broken = |promise: BrokenPromise| ContractViolation::Broken { name, promise };
     let map = param
         .parameterize(disk, boundary)
         .map_err(|e| ContractViolation::Failed {
             name,
-            message: e.to_string(),
+            source: StageFailure::Param(e),
         })?;
     if map.uv.len() != disk.n_vertices() {
-        return Err(broken(format!(
-            "{} points for {} vertices",
-            map.uv.len(),
-            disk.n_vertices()
-        )));
+        return Err(broken(BrokenPromise::PointCount {
+            points: map.uv.len(),
+            vertices: disk.n_vertices(),
+        }));
     }
     if let Some(i) = map
         .uv
         .iter()
         .position(|p| !(p.x.is_finite() && p.y.is_finite()))
     {
-        return Err(broken(format!("the point of v{i} is not finite")));
+        return Err(broken(BrokenPromise::NonFinitePoint(VertexId::new(i))));
     }
     invariants::certify_bijective(&map.uv, &disk.triangles, boundary).map_err(|violation| {
         ContractViolation::Certificate {
@@ -341,10 +485,10 @@ pub fn parameterizer(
         .parameterize(disk, boundary)
         .map_err(|e| ContractViolation::Failed {
             name,
-            message: e.to_string(),
+            source: StageFailure::Param(e),
         })?;
     if again.uv != map.uv {
-        return Err(broken("a second call gave a different map".into()));
+        return Err(broken(BrokenPromise::DifferentMap));
     }
     // An interior face removed: an annulus, not a disk.
     let topo = Topology::build(disk);
@@ -355,9 +499,7 @@ pub fn parameterizer(
         let mut holed = disk.clone();
         holed.triangles.remove(f.idx());
         if param.parameterize(&holed, boundary).is_ok() {
-            return Err(broken(format!(
-                "returned a map of a mesh that is not a disk (face {f} removed)"
-            )));
+            return Err(broken(BrokenPromise::MappedNonDisk(f)));
         }
     }
     Ok(())
@@ -380,7 +522,7 @@ pub fn planar_remesher(
             .remesh(domain, metric, target_length, &mut Rng::seed_from_u64(seed))
             .map_err(|e| ContractViolation::Failed {
                 name,
-                message: e.to_string(),
+                source: StageFailure::Remesh2d(e),
             })
     };
     let out = run(seed)?;
@@ -394,7 +536,7 @@ pub fn planar_remesher(
     if run(seed)? != out {
         return Err(ContractViolation::Broken {
             name,
-            message: "the same seed gave a different mesh".into(),
+            promise: BrokenPromise::NotDeterministic,
         });
     }
     Ok(())
@@ -442,7 +584,16 @@ mod tests {
         };
         // The first patch (the whole disk) is fine; the second has no unprocessed face.
         let e = patch_strategy(&Greedy, &case).expect_err("a broken strategy");
-        assert!(e.to_string().contains("every face processed"), "{e}");
+        assert!(
+            matches!(
+                e,
+                ContractViolation::Broken {
+                    promise: BrokenPromise::PatchWhenDone,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         // On a torus the whole mesh is not a disk.
         let torus = generators::torus(1.0, 0.4, 12, 6);
         let case = StrategyCase {

@@ -26,13 +26,23 @@ pub enum ReportError {
         source: std::io::Error,
     },
     /// plotters failed to draw or encode a plot.
-    #[error("{path}: cannot draw plot: {detail}")]
+    #[error("{path}: cannot draw plot: {source}")]
     Plot {
         /// the PNG file
         path: String,
-        /// plotters' message
-        detail: String,
+        /// plotters' error
+        source: Box<dyn std::error::Error + Send + Sync>,
     },
+}
+
+/// The [`ReportError::Plot`] of a plotters error while drawing `path`.
+fn plot_error<E: std::error::Error + Send + Sync + 'static>(
+    path: &Path,
+) -> impl Fn(E) -> ReportError + '_ {
+    move |e| ReportError::Plot {
+        path: path.display().to_string(),
+        source: Box::new(e),
+    }
 }
 
 /// The font family name the plots use (registered by [`font_available`]).
@@ -111,12 +121,8 @@ const COLORS: [RGBColor; 4] = [
 ];
 
 fn draw_histogram(path: &Path, h: &Histogram, text: bool) -> Result<(), ReportError> {
-    let err = |e: &dyn std::fmt::Display| ReportError::Plot {
-        path: path.display().to_string(),
-        detail: e.to_string(),
-    };
     let root = BitMapBackend::new(path, (960, 600)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
+    root.fill(&WHITE).map_err(plot_error(path))?;
     let n_bins = h.series.first().map_or(1, |s| s.1.len()).max(1);
     let bin_w = h.x_max / n_bins as f64;
     // Percentages of each series' own total.
@@ -141,7 +147,7 @@ fn draw_histogram(path: &Path, h: &Histogram, text: bool) -> Result<(), ReportEr
     }
     let mut chart = builder
         .build_cartesian_2d(0.0..h.x_max, 0.0..y_max)
-        .map_err(|e| err(&e))?;
+        .map_err(plot_error(path))?;
     let x_fmt = |x: &f64| {
         if h.x_max <= 1.0 {
             format!("{x:.1}")
@@ -163,7 +169,7 @@ fn draw_histogram(path: &Path, h: &Histogram, text: bool) -> Result<(), ReportEr
     } else {
         mesh.x_labels(0).y_labels(0);
     }
-    mesh.draw().map_err(|e| err(&e))?;
+    mesh.draw().map_err(plot_error(path))?;
     let k = h.series.len().max(1) as f64;
     for (si, ((label, _), p)) in h.series.iter().zip(&pct).enumerate() {
         let color = COLORS[si % COLORS.len()];
@@ -173,7 +179,7 @@ fn draw_histogram(path: &Path, h: &Histogram, text: bool) -> Result<(), ReportEr
             let x0 = i as f64 * bin_w + 0.05 * bin_w + si as f64 * w;
             Rectangle::new([(x0, 0.0), (x0 + w, v)], color.filled())
         });
-        let drawn = chart.draw_series(bars).map_err(|e| err(&e))?;
+        let drawn = chart.draw_series(bars).map_err(plot_error(path))?;
         if text {
             drawn.label(*label).legend(move |(x, y)| {
                 Rectangle::new([(x, y - 6), (x + 14, y + 6)], color.filled())
@@ -188,9 +194,9 @@ fn draw_histogram(path: &Path, h: &Histogram, text: bool) -> Result<(), ReportEr
             .border_style(BLACK)
             .label_font((FAMILY, 18))
             .draw()
-            .map_err(|e| err(&e))?;
+            .map_err(plot_error(path))?;
     }
-    root.present().map_err(|e| err(&e))?;
+    root.present().map_err(plot_error(path))?;
     Ok(())
 }
 
@@ -320,10 +326,6 @@ pub fn write_strip_plot(
     y_desc: &str,
     groups: &[(&str, Vec<f64>)],
 ) -> Result<(), ReportError> {
-    let err = |e: &dyn std::fmt::Display| ReportError::Plot {
-        path: path.display().to_string(),
-        detail: e.to_string(),
-    };
     let text = font_available();
     let all: Vec<f64> = groups
         .iter()
@@ -343,7 +345,7 @@ pub fn write_strip_plot(
         (lo - pad, hi + pad)
     };
     let root = BitMapBackend::new(path, (720, 480)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
+    root.fill(&WHITE).map_err(plot_error(path))?;
     let n = groups.len().max(1);
     let mut builder = ChartBuilder::on(&root);
     builder.margin(16);
@@ -357,7 +359,7 @@ pub fn write_strip_plot(
     }
     let mut chart = builder
         .build_cartesian_2d(-0.5..(n as f64 - 0.5), lo..hi)
-        .map_err(|e| err(&e))?;
+        .map_err(plot_error(path))?;
     let label = |x: &f64| {
         let i = x.round();
         if (x - i).abs() < 1e-6 && i >= 0.0 {
@@ -379,7 +381,7 @@ pub fn write_strip_plot(
     } else {
         mesh.x_labels(0).y_labels(0);
     }
-    mesh.draw().map_err(|e| err(&e))?;
+    mesh.draw().map_err(plot_error(path))?;
     for (gi, (_, values)) in groups.iter().enumerate() {
         let color = COLORS[(gi + 1) % COLORS.len()];
         let k = values.len().max(1) as f64;
@@ -391,7 +393,7 @@ pub fn write_strip_plot(
                 let x = gi as f64 + 0.3 * ((i as f64 + 0.5) / k - 0.5);
                 Circle::new((x, v), 5, color.filled())
             });
-        chart.draw_series(dots).map_err(|e| err(&e))?;
+        chart.draw_series(dots).map_err(plot_error(path))?;
         let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
         if !finite.is_empty() {
             let mean = finite.iter().sum::<f64>() / finite.len() as f64;
@@ -401,10 +403,10 @@ pub fn write_strip_plot(
                     vec![(x0, mean), (x0 + 0.5, mean)],
                     BLACK.stroke_width(2),
                 )))
-                .map_err(|e| err(&e))?;
+                .map_err(plot_error(path))?;
         }
     }
-    root.present().map_err(|e| err(&e))?;
+    root.present().map_err(plot_error(path))?;
     Ok(())
 }
 

@@ -9,7 +9,7 @@
 
 use conemesh::invariants::{
     certify_manifold, certify_manifold_at, certify_oriented, certify_same_topology,
-    non_manifold_vertices, InvariantError, Offenders,
+    non_manifold_vertices, InvariantError, Offenders, TopologyChange,
 };
 use conemesh::mesh::generators;
 use conemesh::{EdgeKey, FaceId, HalfedgeId, Rng, Topology, TriMesh, VertexId};
@@ -623,7 +623,12 @@ fn same_topology_names_the_first_difference() {
     };
     let what = |a: &TriMesh, b: &TriMesh| match certify_same_topology(a, b) {
         Ok(()) => "same".to_string(),
-        Err(InvariantError::TopologyChanged { what, .. }) => what,
+        Err(InvariantError::TopologyChanged(c)) => match c {
+            TopologyChange::Components { .. } => "components",
+            TopologyChange::BoundaryLoops { .. } => "boundary loops",
+            TopologyChange::PerComponent { .. } => "per-component genus and boundary loops",
+        }
+        .to_string(),
         Err(e) => panic!("{e}"),
     };
     let sphere = generators::icosphere(1.0, 1);
@@ -654,7 +659,15 @@ fn same_topology_names_the_first_difference() {
 #[test]
 fn same_topology_error_shows_both_sides() {
     let sides = |a: &TriMesh, b: &TriMesh| match certify_same_topology(a, b) {
-        Err(InvariantError::TopologyChanged { before, after, .. }) => (before, after),
+        Err(InvariantError::TopologyChanged(c)) => match c {
+            TopologyChange::Components { before, after }
+            | TopologyChange::BoundaryLoops { before, after } => {
+                (before.to_string(), after.to_string())
+            }
+            TopologyChange::PerComponent { before, after } => {
+                (before.to_string(), after.to_string())
+            }
+        },
         other => panic!("{other:?}"),
     };
     let sphere = generators::icosphere(1.0, 1);

@@ -4,7 +4,7 @@
 use conemesh::mesh::generators;
 use conemesh::metric::{
     curvature_metric, principal_curvatures, CurvatureOptions, MetricError, MetricField,
-    MetricOptions, Normalization,
+    MetricOptions, Normalization, SpdDefect,
 };
 use conemesh::{FaceId, SurfaceLocation, TriMesh};
 use nalgebra::{Matrix3, Point3, Vector3};
@@ -230,20 +230,34 @@ fn field_rejects_bad_tensors_by_vertex() -> R {
     bad[7] = -bad[7];
     assert!(matches!(
         MetricField::new(m.clone(), bad).unwrap_err(),
-        MetricError::NotSpd { vertex: 7, .. }
+        MetricError::NotSpd {
+            vertex: 7,
+            defect: SpdDefect::NegativeEigenvalue { .. }
+        }
     ));
     // PSD but zero on the tangent plane: only the normal direction is stretched.
     let mut bad = good.clone();
     let nrm = m.positions[9].coords.normalize();
     bad[9] = nrm * nrm.transpose();
     let e = MetricField::new(m.clone(), bad).unwrap_err();
-    assert!(matches!(e, MetricError::NotSpd { vertex: 9, .. }), "{e}");
-    assert!(e.to_string().contains("v9"));
+    assert!(
+        matches!(
+            e,
+            MetricError::NotSpd {
+                vertex: 9,
+                defect: SpdDefect::TangentIndefinite { .. }
+            }
+        ),
+        "{e}"
+    );
     let mut bad = good;
     bad[3][(0, 1)] += 1.0;
     assert!(matches!(
         MetricField::new(m, bad).unwrap_err(),
-        MetricError::NotSpd { vertex: 3, .. }
+        MetricError::NotSpd {
+            vertex: 3,
+            defect: SpdDefect::NotSymmetric { .. }
+        }
     ));
     Ok(())
 }

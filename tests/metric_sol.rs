@@ -1,6 +1,6 @@
 //! Medit `.sol` metric files: bit-exact round trips and named errors on bad files.
 
-use conemesh::io::sol::{read_sol, write_sol, SolError};
+use conemesh::io::sol::{read_sol, write_sol, SolError, SolSyntax, SolTruncation, SolUnsupported};
 use conemesh::mesh::generators;
 use conemesh::metric::{curvature_metric, MetricError, MetricField, MetricOptions, Normalization};
 use nalgebra::Matrix3;
@@ -129,24 +129,65 @@ fn bad_ascii_files_give_named_errors() -> R {
         &format!("{head}2\n1 3\n1 0 1 0 0 0\n1 0 1\n"),
     )?;
     let e = read_sol(&p, 2).unwrap_err();
-    assert!(matches!(e, SolError::Truncated { .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            SolError::Truncated {
+                missing: SolTruncation::Values {
+                    need: 12,
+                    found: 9,
+                    vertex: 1
+                },
+                ..
+            }
+        ),
+        "{e}"
+    );
     let p = write(
         d,
         "parse.sol",
         &format!("{head}2\n1 3\n1 0 1 0 0 0\n1 0 x 0 0 0\nEnd\n"),
     )?;
     let e = read_sol(&p, 2).unwrap_err();
-    assert!(matches!(e, SolError::Parse { line: 7, .. }), "{e}");
+    assert!(
+        matches!(
+            &e,
+            SolError::Parse {
+                line: 7,
+                defect: SolSyntax::NotANumber { found },
+                ..
+            } if found == "x"
+        ),
+        "{e}"
+    );
     let p = write(d, "type.sol", &format!("{head}2\n1 2\n1 0 1\n1 0 1\nEnd\n"))?;
     let e = read_sol(&p, 2).unwrap_err();
-    assert!(matches!(e, SolError::UnsupportedType { .. }), "{e}");
+    assert!(
+        matches!(
+            &e,
+            SolError::UnsupportedType {
+                what: SolUnsupported::Types { types, .. },
+                ..
+            } if types == &[2]
+        ),
+        "{e}"
+    );
     let p = write(
         d,
         "dim.sol",
         "MeshVersionFormatted 2\nDimension 2\nSolAtVertices\n1\n1 3\n1 0 1\nEnd\n",
     )?;
     let e = read_sol(&p, 1).unwrap_err();
-    assert!(matches!(e, SolError::UnsupportedType { .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            SolError::UnsupportedType {
+                what: SolUnsupported::Dimension(2),
+                ..
+            }
+        ),
+        "{e}"
+    );
     let e = read_sol(&d.join("missing.sol"), 1).unwrap_err();
     assert!(matches!(e, SolError::Io { .. }), "{e}");
     Ok(())
@@ -163,10 +204,28 @@ fn bad_binary_files_give_named_errors() -> R {
     assert!(matches!(e, SolError::CountMismatch { .. }), "{e}");
     std::fs::write(&p, &full[..full.len() - 20])?;
     let e = read_sol(&p, m.n_vertices()).unwrap_err();
-    assert!(matches!(e, SolError::Truncated { .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            SolError::Truncated {
+                missing: SolTruncation::Bytes { .. },
+                ..
+            }
+        ),
+        "{e}"
+    );
     std::fs::write(&p, &full[..10])?;
     let e = read_sol(&p, m.n_vertices()).unwrap_err();
-    assert!(matches!(e, SolError::Truncated { .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            SolError::Truncated {
+                missing: SolTruncation::Word { byte: 8, .. },
+                ..
+            }
+        ),
+        "{e}"
+    );
     // A NaN in the data of vertex 3 (data starts at byte 40, 48 bytes per vertex).
     let mut bad = full.clone();
     bad[40 + 3 * 48 + 16..40 + 3 * 48 + 24].copy_from_slice(&f64::NAN.to_le_bytes());
@@ -272,6 +331,15 @@ fn non_spd_tensor_from_a_sol_file_is_rejected_by_the_field() -> R {
     write_sol(&p, &ms, false)?;
     let back = read_sol(&p, m.n_vertices())?;
     let e = MetricField::new(m, back).unwrap_err();
-    assert!(matches!(e, MetricError::NotSpd { vertex: 11, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            MetricError::NotSpd {
+                vertex: 11,
+                defect: conemesh::metric::SpdDefect::NegativeEigenvalue { .. }
+            }
+        ),
+        "{e}"
+    );
     Ok(())
 }

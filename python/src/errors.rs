@@ -127,7 +127,21 @@ pub fn with_invariant(f: Failure, e: &InvariantError) -> Failure {
                 Attr::Pairs(o.0.iter().map(|p| (p.0 .0 as i64, p.1 .0 as i64)).collect()),
             ),
         ),
-        I::TopologyChanged { .. } => ("topology_changed", f),
+        I::TopologyChanged(c) => {
+            use conemesh::invariants::TopologyChange as T;
+            let f = match c {
+                T::Components { before, after } => f
+                    .with("quantity", Attr::Str("components".into()))
+                    .with("before", Attr::Int(*before as i64))
+                    .with("after", Attr::Int(*after as i64)),
+                T::BoundaryLoops { before, after } => f
+                    .with("quantity", Attr::Str("boundary_loops".into()))
+                    .with("before", Attr::Int(*before as i64))
+                    .with("after", Attr::Int(*after as i64)),
+                T::PerComponent { .. } => f.with("quantity", Attr::Str("per_component".into())),
+            };
+            ("topology_changed", f)
+        }
         I::BoundaryVerticesMoved(o) => (
             "boundary_vertices_moved",
             f.with("vertices", ids(&o.0, |v| v.0 as i64)),
@@ -140,7 +154,7 @@ pub fn with_invariant(f: Failure, e: &InvariantError) -> Failure {
             "boundary_off_curve",
             f.with("vertices", ids(&o.0, |v| v.0 as i64)),
         ),
-        I::BoundaryCurves { .. } => ("boundary_curves", f),
+        I::BoundaryCurves(d) => ("boundary_curves", elements(f, &d.vertices(), &[], &[])),
         I::BoundaryCornersLost(o) => (
             "boundary_corners_lost",
             f.with("vertices", ids(&o.0, |v| v.0 as i64)),
@@ -160,11 +174,42 @@ pub fn with_invariant(f: Failure, e: &InvariantError) -> Failure {
             };
             ("not_a_disk", f)
         }
-        I::NotBijective { .. } => ("not_bijective", f),
+        I::NotBijective(d) => (
+            "not_bijective",
+            elements(f, &d.vertices(), &d.faces(), &d.edges()),
+        ),
         I::FlippedFaces(o) => ("flipped_faces", f.with("faces", ids(&o.0, |x| x.0 as i64))),
-        I::PlanarInvalid { .. } => ("planar_invalid", f),
+        I::PlanarInvalid(d) => (
+            "planar_invalid",
+            elements(f, &d.vertices(), &d.faces(), &d.edges()),
+        ),
     };
     f.with("invariant", Attr::Str(name.into()))
+}
+
+/// The named vertices, faces and directed edges as attributes of `f`, each only when there
+/// are some.
+fn elements(
+    f: Failure,
+    vertices: &[conemesh::VertexId],
+    faces: &[conemesh::FaceId],
+    edges: &[(conemesh::VertexId, conemesh::VertexId)],
+) -> Failure {
+    let f = match vertices {
+        [] => f,
+        v => f.with("vertices", ids(v, |x| x.0 as i64)),
+    };
+    let f = match faces {
+        [] => f,
+        v => f.with("faces", ids(v, |x| x.0 as i64)),
+    };
+    match edges {
+        [] => f,
+        v => f.with(
+            "edges",
+            Attr::Pairs(v.iter().map(|(a, b)| (a.0 as i64, b.0 as i64)).collect()),
+        ),
+    }
 }
 
 pub fn from_metric(e: &MetricError) -> Failure {

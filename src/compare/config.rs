@@ -1,7 +1,7 @@
 //! What a comparison runs: named configurations (`NAME=ARGS` or a TOML file), inputs (files
 //! or folders) and seeds (`1-5`, `1,3,7`), each checked before anything runs.
 
-use super::CompareError;
+use super::{CompareError, ConfigDefect, InputDefect, SeedsDefect};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -37,14 +37,13 @@ impl Config {
     pub fn parse(spec: &str) -> Result<Config, CompareError> {
         let (name, args) = spec.split_once('=').ok_or_else(|| CompareError::Config {
             what: spec.to_string(),
-            detail: "a configuration is NAME=ARGS (e.g. `base=` or `kring=--strategy kring`)"
-                .into(),
+            defect: ConfigDefect::NotNameArgs,
         })?;
         Config::new(
             name.trim(),
             split_args(args).map_err(|e| CompareError::Config {
                 what: spec.to_string(),
-                detail: e.to_string(),
+                defect: ConfigDefect::Quote(e),
             })?,
         )
     }
@@ -53,9 +52,9 @@ impl Config {
     /// letters, digits, `-`, `_` and `.` (it names files), and the arguments leave out
     /// [`OWN_ARGS`].
     pub fn new(name: &str, args: Vec<String>) -> Result<Config, CompareError> {
-        let bad = |detail: String| CompareError::Config {
+        let bad = |defect: ConfigDefect| CompareError::Config {
             what: name.to_string(),
-            detail,
+            defect,
         };
         if name.is_empty()
             || !name
@@ -63,17 +62,15 @@ impl Config {
                 .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
             || name.starts_with('.')
         {
-            return Err(bad(format!(
-                "the name `{name}` must be letters, digits, `-`, `_` or `.` (it names files)"
-            )));
+            return Err(bad(ConfigDefect::BadName {
+                name: name.to_string(),
+            }));
         }
         if let Some(a) = args
             .iter()
             .find(|a| OWN_ARGS.contains(&a.split('=').next().unwrap_or(a)))
         {
-            return Err(bad(format!(
-                "`{a}` is set by compare for every run; leave it out (seeds: --seeds)"
-            )));
+            return Err(bad(ConfigDefect::OwnArg { arg: a.clone() }));
         }
         Ok(Config {
             name: name.to_string(),
@@ -122,14 +119,16 @@ pub fn split_args(s: &str) -> Result<Vec<String>, UnclosedQuote> {
 /// Seeds from `1-5` (inclusive), `3`, or a comma-separated list of both (`1-3,7`); sorted,
 /// without repeats.
 pub fn parse_seeds(spec: &str) -> Result<Vec<u64>, CompareError> {
-    let bad = |detail: String| CompareError::Seeds {
+    let bad = |defect: SeedsDefect| CompareError::Seeds {
         spec: spec.to_string(),
-        detail,
+        defect,
     };
     let num = |s: &str| {
-        s.trim()
-            .parse::<u64>()
-            .map_err(|_| bad(format!("`{}` is not a seed (a whole number ≥ 0)", s.trim())))
+        s.trim().parse::<u64>().map_err(|_| {
+            bad(SeedsDefect::NotASeed {
+                part: s.trim().to_string(),
+            })
+        })
     };
     let mut seeds = Vec::new();
     for part in spec.split(',') {
@@ -137,10 +136,10 @@ pub fn parse_seeds(spec: &str) -> Result<Vec<u64>, CompareError> {
             Some((a, b)) => {
                 let (a, b) = (num(a)?, num(b)?);
                 if a > b {
-                    return Err(bad(format!("the range {a}-{b} is empty (start after end)")));
+                    return Err(bad(SeedsDefect::EmptyRange { start: a, end: b }));
                 }
                 if b - a >= 10_000 {
-                    return Err(bad(format!("the range {a}-{b} has more than 10000 seeds")));
+                    return Err(bad(SeedsDefect::TooMany { start: a, end: b }));
                 }
                 seeds.extend(a..=b);
             }
@@ -188,9 +187,9 @@ pub fn read_config_file(path: &Path) -> Result<Vec<Config>, CompareError> {
         path: file.clone(),
         source,
     })?;
-    let parsed: File = toml::from_str(&text).map_err(|e| CompareError::ConfigFile {
+    let parsed: File = toml::from_str(&text).map_err(|source| CompareError::ConfigToml {
         path: file.clone(),
-        detail: e.to_string(),
+        source,
     })?;
     parsed
         .config
@@ -198,9 +197,9 @@ pub fn read_config_file(path: &Path) -> Result<Vec<Config>, CompareError> {
         .map(|e| {
             let args = match e.args {
                 Args::None => Vec::new(),
-                Args::Line(s) => split_args(&s).map_err(|e| CompareError::ConfigFile {
+                Args::Line(s) => split_args(&s).map_err(|source| CompareError::ConfigQuote {
                     path: file.clone(),
-                    detail: e.to_string(),
+                    source,
                 })?,
                 Args::List(l) => l,
             };
@@ -214,14 +213,14 @@ pub fn check_configs(configs: &[Config]) -> Result<(), CompareError> {
     if configs.is_empty() {
         return Err(CompareError::Config {
             what: "(none)".into(),
-            detail: "no configuration: give `-c NAME=ARGS` or `--config FILE.toml`".into(),
+            defect: ConfigDefect::None,
         });
     }
     for (i, c) in configs.iter().enumerate() {
         if configs[..i].iter().any(|d| d.name == c.name) {
             return Err(CompareError::Config {
                 what: c.name.clone(),
-                detail: "two configurations have this name".into(),
+                defect: ConfigDefect::SameName,
             });
         }
     }
@@ -244,14 +243,14 @@ pub fn collect_inputs(paths: &[PathBuf]) -> Result<Vec<Input>, CompareError> {
     if paths.is_empty() {
         return Err(CompareError::Input {
             path: "(none)".into(),
-            detail: "no input: give mesh files or folders".into(),
+            defect: InputDefect::None,
         });
     }
     let mut files = Vec::new();
     for p in paths {
-        let bad = |detail: &str| CompareError::Input {
+        let bad = |defect: InputDefect| CompareError::Input {
             path: p.display().to_string(),
-            detail: detail.into(),
+            defect,
         };
         if p.is_dir() {
             let mut found: Vec<PathBuf> = std::fs::read_dir(p)
@@ -263,16 +262,14 @@ pub fn collect_inputs(paths: &[PathBuf]) -> Result<Vec<Input>, CompareError> {
                 .filter(|f| f.is_file() && is_mesh_file(f))
                 .collect();
             if found.is_empty() {
-                return Err(bad(
-                    "the folder holds no mesh file (.obj, .off, .ply, .stl, .mesh)",
-                ));
+                return Err(bad(InputDefect::NoMeshFile));
             }
             found.sort();
             files.extend(found);
         } else if p.is_file() {
             files.push(p.clone());
         } else {
-            return Err(bad("no such file or folder"));
+            return Err(bad(InputDefect::Missing));
         }
     }
     let mut inputs: Vec<Input> = Vec::new();
@@ -288,10 +285,10 @@ pub fn collect_inputs(paths: &[PathBuf]) -> Result<Vec<Input>, CompareError> {
         if let Some(other) = inputs.iter().find(|i| i.name == name) {
             return Err(CompareError::Input {
                 path: f.display().to_string(),
-                detail: format!(
-                    "shares the name `{name}` with {} (outputs are named by it)",
-                    other.path.display()
-                ),
+                defect: InputDefect::SameName {
+                    name,
+                    other: other.path.clone(),
+                },
             });
         }
         inputs.push(Input { path, name });

@@ -8,8 +8,9 @@ use super::process::{error_line, run_timed, ChildError};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, ExitStatus};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::sync::Mutex;
 use std::time::Duration;
 
@@ -61,8 +62,45 @@ impl std::fmt::Display for Status {
     }
 }
 
+/// Why a run has no picture. `compare.json` holds its message, the text a reader sees.
+#[derive(Clone, Debug, thiserror::Error)]
+pub enum PictureError {
+    /// The run wrote no output to draw.
+    #[error("no output")]
+    NoOutput,
+    /// Pictures were not asked for (`--no-pictures`).
+    #[error("pictures off")]
+    Off,
+    /// The binary's `render --help` fails: it has no `render` subcommand.
+    #[error("no picture: this conemesh has no `render` subcommand")]
+    NoRender,
+    /// The binary's `render --help` gave no exit status.
+    #[error("no picture: render {0}")]
+    RenderUnavailable(#[source] Arc<ChildError>),
+    /// `conemesh render` gave no exit status.
+    #[error("render {0}")]
+    Child(#[source] Arc<ChildError>),
+    /// `conemesh render` failed; `message` is the line of its stderr that names the error.
+    #[error("render {status}: {message}")]
+    Failed {
+        /// its exit status
+        status: ExitStatus,
+        /// the line of its stderr that names the error
+        message: String,
+    },
+    /// `conemesh render` succeeded without writing the picture.
+    #[error("render wrote no picture")]
+    NoPicture,
+}
+
+impl Serialize for PictureError {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
 /// One (configuration, input, seed) of the grid and what it gave.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize)]
 pub struct RunRecord {
     /// configuration name
     pub config: String,
@@ -81,7 +119,7 @@ pub struct RunRecord {
     /// the measures, options and histograms (ok runs)
     pub result: Option<RunResult>,
     /// the picture's file name, or why there is none
-    pub picture: Result<String, String>,
+    pub picture: Result<String, PictureError>,
     /// the process's wall time, seconds (`None` when it timed out or did not start)
     pub wall: Option<f64>,
 }
@@ -230,7 +268,7 @@ impl Grid {
         &self,
         job: Job,
         dir: &Path,
-        render: Option<&Result<(), String>>,
+        render: Option<&Result<(), PictureError>>,
     ) -> Result<RunRecord, super::CompareError> {
         let c = &self.configs[job.config];
         let input = &self.inputs[job.input];
@@ -245,13 +283,13 @@ impl Grid {
             files: files.clone(),
             output_sha256: None,
             result: None,
-            picture: Err("no output".into()),
+            picture: Err(PictureError::NoOutput),
             wall: None,
         };
         self.remesh(job, dir, &mut log, &mut rec);
         if rec.status == Status::Ok {
             rec.picture = match render {
-                None => Err("pictures off".into()),
+                None => Err(PictureError::Off),
                 Some(Err(why)) => Err(why.clone()),
                 Some(Ok(())) => self.picture(input, dir, &files, &mut log),
             };
@@ -314,7 +352,7 @@ impl Grid {
         dir: &Path,
         files: &RunFiles,
         log: &mut Vec<u8>,
-    ) -> Result<String, String> {
+    ) -> Result<String, PictureError> {
         let pic = files.picture();
         let mut cmd = Command::new(&self.exe);
         cmd.arg("render")
@@ -325,19 +363,18 @@ impl Grid {
             .arg(dir.join(&files.metric))
             .arg("--reference")
             .arg(&input.path);
-        let f = run_timed(&mut cmd, self.timeout).map_err(|e| format!("render {e}"))?;
+        let f = run_timed(&mut cmd, self.timeout).map_err(|e| PictureError::Child(Arc::new(e)))?;
         log.extend_from_slice(b"\n--- conemesh render ---\n");
         log.extend_from_slice(&f.stdout);
         log.extend_from_slice(&f.stderr);
         if !f.status.success() {
-            return Err(format!(
-                "render {}: {}",
-                f.status,
-                error_line(&String::from_utf8_lossy(&f.stderr))
-            ));
+            return Err(PictureError::Failed {
+                status: f.status,
+                message: error_line(&String::from_utf8_lossy(&f.stderr)).to_string(),
+            });
         }
         if !dir.join(&pic).is_file() {
-            return Err("render wrote no picture".into());
+            return Err(PictureError::NoPicture);
         }
         Ok(pic)
     }
@@ -345,13 +382,13 @@ impl Grid {
 
 /// Whether `exe` has the `render` subcommand: its `render --help` succeeds. A binary without
 /// it answers with clap's usage error; the reason is what every row then records.
-fn render_available(exe: &Path, timeout: Duration) -> Result<(), String> {
+fn render_available(exe: &Path, timeout: Duration) -> Result<(), PictureError> {
     let mut cmd = Command::new(exe);
     cmd.args(["render", "--help"]);
     match run_timed(&mut cmd, timeout) {
         Ok(f) if f.status.success() => Ok(()),
-        Ok(_) => Err("no picture: this conemesh has no `render` subcommand".into()),
-        Err(e) => Err(format!("no picture: render {e}")),
+        Ok(_) => Err(PictureError::NoRender),
+        Err(e) => Err(PictureError::RenderUnavailable(Arc::new(e))),
     }
 }
 
@@ -368,7 +405,7 @@ fn read_result(dir: &Path, files: &RunFiles) -> Result<(String, RunResult), supe
     let json: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| super::CompareError::Report {
             path: report.display().to_string(),
-            detail: e.to_string(),
+            defect: super::ReportDefect::NotJson(e),
         })?;
     let result = RunResult::from_report(&json, &files.report)?;
     Ok((sha, result))

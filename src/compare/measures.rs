@@ -3,7 +3,7 @@
 //! retries, faces, and the machine's time and peak memory.
 
 use super::stats::Better;
-use super::CompareError;
+use super::{CompareError, ReportDefect};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -28,8 +28,10 @@ pub struct Measure {
     kind: Kind,
 }
 
+/// How a report's value becomes a measure.
 #[derive(Clone, Copy, Debug)]
-enum Kind {
+pub enum Kind {
+    /// a number as it is
     Number,
     /// a fraction shown in %
     Percent,
@@ -179,9 +181,9 @@ pub struct RunResult {
 impl RunResult {
     /// Read a `conemesh remesh --report` document; `path` names it in errors.
     pub fn from_report(json: &serde_json::Value, path: &str) -> Result<RunResult, CompareError> {
-        let bad = |what: String| CompareError::Report {
+        let bad = |defect: ReportDefect| CompareError::Report {
             path: path.to_string(),
-            detail: what,
+            defect,
         };
         let mut measures = BTreeMap::new();
         for m in &MEASURES {
@@ -189,20 +191,27 @@ impl RunResult {
                 .path
                 .iter()
                 .try_fold(json, |v, k| v.get(k))
-                .ok_or_else(|| bad(format!("no `{}`", m.path.join("."))))?;
+                .ok_or_else(|| bad(ReportDefect::Missing(m.path)))?;
             let x = match m.kind {
                 Kind::Number => v.as_f64(),
                 Kind::Percent => v.as_f64().map(|x| 100.0 * x),
                 Kind::Count => v.as_array().map(|a| a.len() as f64),
             }
-            .ok_or_else(|| bad(format!("`{}` is not a {:?}", m.path.join("."), m.kind)))?;
+            .ok_or_else(|| {
+                bad(ReportDefect::WrongType {
+                    path: m.path,
+                    kind: m.kind,
+                })
+            })?;
             measures.insert(m.key.to_string(), x);
         }
-        let run = json.get("run").ok_or_else(|| bad("no `run`".into()))?;
+        let run = json
+            .get("run")
+            .ok_or_else(|| bad(ReportDefect::Missing(&["run"])))?;
         let mut opts = run
             .get("options")
             .cloned()
-            .ok_or_else(|| bad("no `run.options`".into()))?;
+            .ok_or_else(|| bad(ReportDefect::Missing(&["run", "options"])))?;
         if let Some(o) = opts.as_object_mut() {
             o.remove("debug_dir");
         }
@@ -214,10 +223,8 @@ impl RunResult {
         let quality = json
             .pointer("/eval/output_quality")
             .cloned()
-            .ok_or_else(|| bad("no `eval.output_quality`".into()))
-            .and_then(|q| {
-                serde_json::from_value(q).map_err(|e| bad(format!("eval.output_quality: {e}")))
-            })?;
+            .ok_or_else(|| bad(ReportDefect::Missing(&["eval", "output_quality"])))
+            .and_then(|q| serde_json::from_value(q).map_err(|e| bad(ReportDefect::Quality(e))))?;
         Ok(RunResult {
             measures,
             options,

@@ -21,7 +21,7 @@ pub mod snapshot;
 pub mod stats;
 
 pub use config::{Config, Input};
-pub use grid::{Grid, Job, RunRecord, Status};
+pub use grid::{Grid, Job, PictureError, RunRecord, Status};
 pub use snapshot::{Drift, Snapshot};
 
 use measures::MEASURES;
@@ -32,52 +32,60 @@ use std::collections::BTreeMap;
 #[derive(Debug, thiserror::Error)]
 pub enum CompareError {
     /// A configuration (`NAME=ARGS`) that cannot run.
-    #[error("configuration `{what}`: {detail}")]
+    #[error("configuration `{what}`: {defect}")]
     Config {
         /// the configuration as given, or its name
         what: String,
         /// what is wrong
-        detail: String,
+        defect: ConfigDefect,
     },
-    /// A configuration file that does not parse.
-    #[error("{path}: {detail}")]
-    ConfigFile {
+    /// A configuration file that is not TOML of the expected form.
+    #[error("{path}: {source}")]
+    ConfigToml {
         /// the TOML file
         path: String,
-        /// the parser's message
-        detail: String,
+        /// the parser's error
+        source: toml::de::Error,
+    },
+    /// A configuration file whose argument line has an unclosed quote.
+    #[error("{path}: {source}")]
+    ConfigQuote {
+        /// the TOML file
+        path: String,
+        /// the line and its quote
+        source: config::UnclosedQuote,
     },
     /// A bad `--seeds`.
-    #[error("--seeds `{spec}`: {detail}")]
+    #[error("--seeds `{spec}`: {defect}")]
     Seeds {
         /// as given
         spec: String,
         /// what is wrong
-        detail: String,
+        defect: SeedsDefect,
     },
     /// An input that cannot be run.
-    #[error("input {path}: {detail}")]
+    #[error("input {path}: {defect}")]
     Input {
         /// the file or folder
         path: String,
         /// what is wrong
-        detail: String,
+        defect: InputDefect,
     },
     /// A report without the expected numbers.
-    #[error("report {path}: {detail}")]
+    #[error("report {path}: {defect}")]
     Report {
         /// the report
         path: String,
         /// what is missing
-        detail: String,
+        defect: ReportDefect,
     },
     /// A snapshot file that cannot be checked.
-    #[error("snapshot {path}: {detail}")]
+    #[error("snapshot {path}: {defect}")]
     Snapshot {
         /// the snapshot file
         path: String,
         /// what is wrong
-        detail: String,
+        defect: SnapshotDefect,
     },
     /// Operating-system error on a path.
     #[error("{path}: {source}")]
@@ -90,6 +98,144 @@ pub enum CompareError {
     /// A plot could not be drawn.
     #[error(transparent)]
     Plot(#[from] crate::report::ReportError),
+}
+
+/// What is wrong with a configuration ([`CompareError::Config`]).
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigDefect {
+    /// Not of the form `NAME=ARGS`.
+    #[error("a configuration is NAME=ARGS (e.g. `base=` or `kring=--strategy kring`)")]
+    NotNameArgs,
+    /// Its argument line has an unclosed quote.
+    #[error(transparent)]
+    Quote(#[from] config::UnclosedQuote),
+    /// A name that cannot name files.
+    #[error("the name `{name}` must be letters, digits, `-`, `_` or `.` (it names files)")]
+    BadName {
+        /// the name
+        name: String,
+    },
+    /// An argument compare sets itself ([`config::OWN_ARGS`]).
+    #[error("`{arg}` is set by compare for every run; leave it out (seeds: --seeds)")]
+    OwnArg {
+        /// the argument
+        arg: String,
+    },
+    /// No configuration at all.
+    #[error("no configuration: give `-c NAME=ARGS` or `--config FILE.toml`")]
+    None,
+    /// Two configurations share the name.
+    #[error("two configurations have this name")]
+    SameName,
+}
+
+/// What is wrong with `--seeds` ([`CompareError::Seeds`]).
+#[derive(Debug, thiserror::Error)]
+pub enum SeedsDefect {
+    /// A part that is not a whole number.
+    #[error("`{part}` is not a seed (a whole number ≥ 0)")]
+    NotASeed {
+        /// the part
+        part: String,
+    },
+    /// A range whose start is after its end.
+    #[error("the range {start}-{end} is empty (start after end)")]
+    EmptyRange {
+        /// first seed
+        start: u64,
+        /// last seed
+        end: u64,
+    },
+    /// A range of more than 10000 seeds.
+    #[error("the range {start}-{end} has more than 10000 seeds")]
+    TooMany {
+        /// first seed
+        start: u64,
+        /// last seed
+        end: u64,
+    },
+}
+
+/// What is wrong with an input ([`CompareError::Input`]).
+#[derive(Debug, thiserror::Error)]
+pub enum InputDefect {
+    /// No input at all.
+    #[error("no input: give mesh files or folders")]
+    None,
+    /// A folder without mesh files.
+    #[error("the folder holds no mesh file (.obj, .off, .ply, .stl, .mesh)")]
+    NoMeshFile,
+    /// Neither a file nor a folder.
+    #[error("no such file or folder")]
+    Missing,
+    /// Two inputs with one name (the file stem), which names their outputs.
+    #[error("shares the name `{name}` with {} (outputs are named by it)", other.display())]
+    SameName {
+        /// the shared name
+        name: String,
+        /// the other input
+        other: std::path::PathBuf,
+    },
+}
+
+/// What a run's report lacks ([`CompareError::Report`]).
+#[derive(Debug, thiserror::Error)]
+pub enum ReportDefect {
+    /// It is not JSON.
+    #[error(transparent)]
+    NotJson(serde_json::Error),
+    /// A field it does not have (its keys from the top).
+    #[error("no `{}`", .0.join("."))]
+    Missing(&'static [&'static str]),
+    /// A field of another type.
+    #[error("`{}` is not a {kind:?}", path.join("."))]
+    WrongType {
+        /// the keys from the top
+        path: &'static [&'static str],
+        /// what it should be
+        kind: measures::Kind,
+    },
+    /// `eval.output_quality` is not the quality statistics.
+    #[error("eval.output_quality: {0}")]
+    Quality(#[source] serde_json::Error),
+}
+
+/// What is wrong with a snapshot file ([`CompareError::Snapshot`]).
+#[derive(Debug, thiserror::Error)]
+pub enum SnapshotDefect {
+    /// It cannot be read.
+    #[error(transparent)]
+    Unreadable(std::io::Error),
+    /// It is not a snapshot's JSON.
+    #[error(transparent)]
+    NotJson(serde_json::Error),
+    /// Another format.
+    #[error("format `{found}`, this conemesh reads `{}`", snapshot::FORMAT)]
+    Format {
+        /// the format it names
+        found: String,
+    },
+    /// A configuration it lists cannot run.
+    #[error(transparent)]
+    Config(Box<CompareError>),
+    /// A time limit that is not a positive time.
+    #[error("timeout_s {0} is not a positive time")]
+    Timeout(f64),
+    /// It lists no runs.
+    #[error("it lists no runs")]
+    NoRuns,
+    /// A run names a configuration it does not list.
+    #[error("run {run} names no listed configuration")]
+    UnknownConfig {
+        /// the run's label
+        run: String,
+    },
+    /// A run names an input it does not list.
+    #[error("run {run} names no listed input")]
+    UnknownInput {
+        /// the run's label
+        run: String,
+    },
 }
 
 /// The bootstrap stream of configuration `config` (its index in the grid, the first being 0)

@@ -367,7 +367,11 @@ fn html_outputs(s: &mut String, c: &Comparison, dir: &Path) {
         match &r.picture {
             Ok(file) => figure(s, dir, file, &r.files.output, "picture"),
             Err(why) => {
-                let _ = write!(s, "<span class=\"no-picture\">{}</span>", esc(why));
+                let _ = write!(
+                    s,
+                    "<span class=\"no-picture\">{}</span>",
+                    esc(&why.to_string())
+                );
             }
         }
         s.push_str("</td></tr>\n");

@@ -7,7 +7,7 @@
 use super::config::{Config, Input};
 use super::grid::{Grid, Job, RunRecord, Status};
 use super::measures::MEASURES;
-use super::CompareError;
+use super::{CompareError, SnapshotDefect};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -150,40 +150,35 @@ impl Snapshot {
     /// Read and check a snapshot file: JSON of this format whose runs name its own
     /// configurations and inputs.
     pub fn read(path: &Path) -> Result<Snapshot, CompareError> {
-        let bad = |detail: String| CompareError::Snapshot {
+        let bad = |defect: SnapshotDefect| CompareError::Snapshot {
             path: path.display().to_string(),
-            detail,
+            defect,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
-        let s: Snapshot = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        let config = |e: CompareError| bad(SnapshotDefect::Config(Box::new(e)));
+        let text = std::fs::read_to_string(path).map_err(|e| bad(SnapshotDefect::Unreadable(e)))?;
+        let s: Snapshot =
+            serde_json::from_str(&text).map_err(|e| bad(SnapshotDefect::NotJson(e)))?;
         if s.format != FORMAT {
-            return Err(bad(format!(
-                "format `{}`, this conemesh reads `{FORMAT}`",
-                s.format
-            )));
+            return Err(bad(SnapshotDefect::Format {
+                found: s.format.clone(),
+            }));
         }
-        super::config::check_configs(&s.configs).map_err(|e| bad(e.to_string()))?;
+        super::config::check_configs(&s.configs).map_err(config)?;
         for c in &s.configs {
-            Config::new(&c.name, c.args.clone()).map_err(|e| bad(e.to_string()))?;
+            Config::new(&c.name, c.args.clone()).map_err(config)?;
         }
         if !(s.timeout_s > 0.0 && s.timeout_s.is_finite()) {
-            return Err(bad(format!(
-                "timeout_s {} is not a positive time",
-                s.timeout_s
-            )));
+            return Err(bad(SnapshotDefect::Timeout(s.timeout_s)));
         }
         if s.runs.is_empty() {
-            return Err(bad("it lists no runs".into()));
+            return Err(bad(SnapshotDefect::NoRuns));
         }
         for r in &s.runs {
             if !s.configs.iter().any(|c| c.name == r.config) {
-                return Err(bad(format!(
-                    "run {} names no listed configuration",
-                    r.label()
-                )));
+                return Err(bad(SnapshotDefect::UnknownConfig { run: r.label() }));
             }
             if !s.inputs.iter().any(|i| i.name == r.mesh) {
-                return Err(bad(format!("run {} names no listed input", r.label())));
+                return Err(bad(SnapshotDefect::UnknownInput { run: r.label() }));
             }
         }
         Ok(s)

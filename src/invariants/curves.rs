@@ -1,13 +1,13 @@
 //! The boundary certificate: the output's boundary lies on the input's boundary curves
 //! ([`crate::boundary`]), each loop once around its curve, every corner kept.
 
-use super::{InvariantError, Offenders};
+use super::{CurvesDefect, InvariantError, Offenders};
 use crate::boundary::{BoundaryCurves, CurvePoint};
 use crate::ids::VertexId;
 use crate::mesh::{Topology, TriMesh};
 
-fn broken(reason: String) -> InvariantError {
-    InvariantError::BoundaryCurves { reason }
+fn broken(defect: CurvesDefect) -> InvariantError {
+    InvariantError::BoundaryCurves(defect)
 }
 
 /// The boundary of `mesh` (topology `topo`) lies on the boundary curves of `reference`, with
@@ -48,11 +48,10 @@ pub fn certify_boundary_on_curves(
         return Err(InvariantError::BoundaryOffCurve(Offenders(off)));
     }
     if loops.len() != curves.len() {
-        return Err(broken(format!(
-            "{} boundary loops for {} input boundary curves",
-            loops.len(),
-            curves.len()
-        )));
+        return Err(broken(CurvesDefect::LoopCount {
+            loops: loops.len(),
+            curves: curves.len(),
+        }));
     }
     let mut seen = vec![false; curves.len()];
     let mut lost = Vec::new();
@@ -60,16 +59,17 @@ pub fn certify_boundary_on_curves(
         let ps: Vec<CurvePoint> = l.iter().filter_map(|&v| point(v)).collect();
         let c = ps[0].curve;
         if let Some(i) = ps.iter().position(|p| p.curve != c) {
-            return Err(broken(format!(
-                "the loop through {} and {} lies on two curves ({} and {})",
-                l[0], l[i], c, ps[i].curve
-            )));
+            return Err(broken(CurvesDefect::TwoCurves {
+                first: l[0],
+                other: l[i],
+                curves: (c, ps[i].curve),
+            }));
         }
         if std::mem::replace(&mut seen[c as usize], true) {
-            return Err(broken(format!(
-                "two loops lie on curve {c} (one through {})",
-                l[0]
-            )));
+            return Err(broken(CurvesDefect::SharedCurve {
+                curve: c,
+                through: l[0],
+            }));
         }
         // Once around: exactly one descent in the cyclic sequence (where it passes the
         // curve's first vertex), every other step strictly forward.
@@ -79,10 +79,12 @@ pub fn certify_boundary_on_curves(
             .collect();
         if n < 3 || descents.len() != 1 {
             let at = descents.get(1).or(descents.first()).map_or(l[0], |&i| l[i]);
-            return Err(broken(format!(
-                "the loop through {at} does not go once around curve {c} in its direction ({} backward steps among {n} vertices)",
-                descents.len()
-            )));
+            return Err(broken(CurvesDefect::NotOnceAround {
+                at,
+                curve: c,
+                backward: descents.len(),
+                vertices: n,
+            }));
         }
         let on_loop: Vec<(u32, f64)> = ps.iter().map(|p| (p.edge, p.t)).collect();
         for (i, &v) in curves.curve(c as usize).iter().enumerate() {
@@ -141,7 +143,7 @@ mod tests {
         sp.swap(l[1].idx(), l[2].idx());
         assert!(matches!(
             certify_boundary_on_curves(&c, &d, &swapped, &t, &sp),
-            Err(InvariantError::BoundaryCurves { .. })
+            Err(InvariantError::BoundaryCurves(_))
         ));
         // A point moved along the curve (still on it) keeps the certificate.
         let mut slid = d.clone();

@@ -2,7 +2,7 @@
 //! self-intersections, topology kept, boundary kept. Every geometric decision is an exact
 //! predicate from [`crate::predicates`].
 
-use super::{EdgeFaces, FacePair, InvariantError, Offenders};
+use super::{ComponentTopologies, EdgeFaces, FacePair, InvariantError, Offenders, TopologyChange};
 use crate::ids::{EdgeKey, FaceId, VertexId};
 use crate::mesh::{Topology, TriMesh};
 use crate::predicates::{
@@ -224,14 +224,6 @@ pub fn certify_no_self_intersections(mesh: &TriMesh) -> Result<(), InvariantErro
     }
 }
 
-fn changed(what: &str, before: String, after: String) -> InvariantError {
-    InvariantError::TopologyChanged {
-        what: what.to_string(),
-        before,
-        after,
-    }
-}
-
 /// The topology a run must keep: the number of components and boundary loops and the
 /// per-component `(genus, boundary loops)`, sorted so that renumbered components compare
 /// equal. A genus that is not a non-negative integer prints as `?`.
@@ -262,39 +254,31 @@ impl TopologySignature {
     /// loops, then the per-component genus and loops.
     pub fn certify_same(&self, after: &TopologySignature) -> Result<(), InvariantError> {
         if self.components != after.components {
-            return Err(changed(
-                "components",
-                self.components.to_string(),
-                after.components.to_string(),
+            return Err(InvariantError::TopologyChanged(
+                TopologyChange::Components {
+                    before: self.components,
+                    after: after.components,
+                },
             ));
         }
         if self.boundary_loops != after.boundary_loops {
-            return Err(changed(
-                "boundary loops",
-                self.boundary_loops.to_string(),
-                after.boundary_loops.to_string(),
+            return Err(InvariantError::TopologyChanged(
+                TopologyChange::BoundaryLoops {
+                    before: self.boundary_loops,
+                    after: after.boundary_loops,
+                },
             ));
         }
         if self.per_component != after.per_component {
-            return Err(changed(
-                "per-component genus and boundary loops",
-                fmt_signature(&self.per_component),
-                fmt_signature(&after.per_component),
+            return Err(InvariantError::TopologyChanged(
+                TopologyChange::PerComponent {
+                    before: ComponentTopologies(self.per_component.clone()),
+                    after: ComponentTopologies(after.per_component.clone()),
+                },
             ));
         }
         Ok(())
     }
-}
-
-fn fmt_signature(v: &[(Option<u32>, usize)]) -> String {
-    let parts: Vec<String> = v
-        .iter()
-        .map(|(g, b)| {
-            let g = g.map_or("?".to_string(), |g| g.to_string());
-            format!("(genus {g}, {b} loops)")
-        })
-        .collect();
-    format!("[{}]", parts.join(", "))
 }
 
 /// `after` has the topology of `before`: the same number of connected components, the same
@@ -623,13 +607,22 @@ mod tests {
         let sphere = generators::icosphere(1.0, 1);
         let e = certify_same_topology(&torus, &sphere).unwrap_err();
         assert!(
-            matches!(e, InvariantError::TopologyChanged { ref what, .. } if what.contains("genus")),
+            matches!(
+                e,
+                InvariantError::TopologyChanged(TopologyChange::PerComponent { .. })
+            ),
             "{e}"
         );
         let disk = generators::disk(1.0, 3, 8);
         let e = certify_same_topology(&disk, &sphere).unwrap_err();
         assert!(
-            matches!(e, InvariantError::TopologyChanged { ref what, .. } if what == "boundary loops"),
+            matches!(
+                e,
+                InvariantError::TopologyChanged(TopologyChange::BoundaryLoops {
+                    before: 1,
+                    after: 0
+                })
+            ),
             "{e}"
         );
         let mut two = sphere.clone();
@@ -648,7 +641,13 @@ mod tests {
         );
         let e = certify_same_topology(&sphere, &two).unwrap_err();
         assert!(
-            matches!(e, InvariantError::TopologyChanged { ref what, .. } if what == "components"),
+            matches!(
+                e,
+                InvariantError::TopologyChanged(TopologyChange::Components {
+                    before: 1,
+                    after: 2
+                })
+            ),
             "{e}"
         );
 

@@ -80,15 +80,8 @@ pub enum InvariantError {
     #[error("self-intersecting face pairs: {0}")]
     SelfIntersections(Offenders<FacePair>),
     /// Genus, component count or boundary-loop count changed.
-    #[error("topology changed: {what} was {before}, is {after}")]
-    TopologyChanged {
-        /// which quantity
-        what: String,
-        /// before
-        before: String,
-        /// after
-        after: String,
-    },
+    #[error("topology changed: {0}")]
+    TopologyChanged(TopologyChange),
     /// Input boundary vertices that moved or vanished.
     #[error("boundary vertices not preserved: {0}")]
     BoundaryVerticesMoved(Offenders<VertexId>),
@@ -100,11 +93,8 @@ pub enum InvariantError {
     #[error("boundary vertices not on the input's boundary curves: {0}")]
     BoundaryOffCurve(Offenders<VertexId>),
     /// Boundary loops that do not go once around the input's curves.
-    #[error("boundary curves not followed: {reason}")]
-    BoundaryCurves {
-        /// which loop, naming a vertex
-        reason: String,
-    },
+    #[error("boundary curves not followed: {0}")]
+    BoundaryCurves(CurvesDefect),
     /// Corners of the input's boundary curves that are not output vertices.
     #[error("boundary corners lost (input vertices): {0}")]
     BoundaryCornersLost(Offenders<VertexId>),
@@ -113,26 +103,25 @@ pub enum InvariantError {
     #[error("not a disk: {0}")]
     NotADisk(DiskDefect),
     /// A 2D map with non-positive triangles or a self-touching boundary.
-    #[error("map is not bijective: {reason}")]
-    NotBijective {
-        /// which triangles / boundary edges
-        reason: String,
-    },
+    #[error("map is not bijective: {0}")]
+    NotBijective(MapDefect),
     /// Faces whose normal is more than 90° from the reference surface's normal.
     #[error("flipped faces relative to the reference surface: {0}")]
     FlippedFaces(Offenders<FaceId>),
     /// A planar remeshing result that broke its contract (boundary, area, orientation).
-    #[error("planar mesh invalid: {reason}")]
-    PlanarInvalid {
-        /// what is wrong, naming the vertex or triangle
-        reason: String,
-    },
+    #[error("planar mesh invalid: {0}")]
+    PlanarInvalid(PlanarDefect),
 }
 
 mod disk;
 pub use disk::*;
 mod disk_defect;
 pub use disk_defect::DiskDefect;
+mod defects;
+pub use defects::{
+    ComponentTopologies, CurvesDefect, DirectedEdge, InputVertex, MapDefect, PlanarDefect,
+    TopologyChange,
+};
 mod bijective;
 pub use bijective::*;
 

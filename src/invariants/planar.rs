@@ -1,23 +1,25 @@
 //! Certificate of a planar remeshing result (Sec. 3.3): the output triangulates exactly the
 //! input polygon, with the boundary loop and constrained edges kept bit for bit.
 
-use super::InvariantError;
+use super::{DirectedEdge, InputVertex, InvariantError, Offenders, PlanarDefect};
+use crate::ids::{FaceId, VertexId};
 use crate::mesh::{PlanarDomain, PlanarMesh};
 use crate::predicates::{orient2d, Sign};
 use nalgebra::Point2;
 use std::collections::HashMap;
 
-fn invalid(reason: String) -> InvariantError {
-    InvariantError::PlanarInvalid { reason }
+fn invalid(defect: PlanarDefect) -> InvariantError {
+    InvariantError::PlanarInvalid(defect)
 }
 
-/// Names of at most ten elements, then the count of the rest.
-fn list<T: std::fmt::Display>(xs: &[T]) -> String {
-    let mut s: Vec<String> = xs.iter().take(10).map(|x| x.to_string()).collect();
-    if xs.len() > 10 {
-        s.push(format!("… and {} more", xs.len() - 10));
-    }
-    s.join(", ")
+/// The vertex with index `i` of a planar mesh or domain.
+fn v(i: u32) -> VertexId {
+    VertexId(i)
+}
+
+/// The edge `a → b` of a planar mesh or domain.
+fn edge(a: u32, b: u32) -> DirectedEdge {
+    DirectedEdge(v(a), v(b))
 }
 
 /// Twice the signed area of a polygon (shoelace; floating point).
@@ -173,28 +175,27 @@ pub fn certify_planar(domain: &PlanarDomain, out: &PlanarMesh) -> Result<(), Inv
 fn points_and_orientation(out: &PlanarMesh) -> Result<usize, InvariantError> {
     let np = out.points.len();
     if out.origin.len() != np {
-        return Err(invalid(format!(
-            "{} points but {} origin entries",
-            np,
-            out.origin.len()
-        )));
+        return Err(invalid(PlanarDefect::OriginCount {
+            points: np,
+            origins: out.origin.len(),
+        }));
     }
     if let Some(i) = out
         .points
         .iter()
         .position(|p| !p.x.is_finite() || !p.y.is_finite())
     {
-        return Err(invalid(format!("point v{i} is not finite")));
+        return Err(invalid(PlanarDefect::NonFinitePoint(VertexId::new(i))));
     }
     if let Some(f) = out
         .triangles
         .iter()
         .position(|t| t.iter().any(|&i| i as usize >= np))
     {
-        return Err(invalid(format!("triangle f{f} has an out-of-range vertex")));
+        return Err(invalid(PlanarDefect::VertexOutOfRange(FaceId::new(f))));
     }
     // (2) orientation.
-    let bad: Vec<String> = out
+    let bad: Vec<FaceId> = out
         .triangles
         .iter()
         .enumerate()
@@ -202,10 +203,10 @@ fn points_and_orientation(out: &PlanarMesh) -> Result<usize, InvariantError> {
             let [a, b, c] = t.map(|i| out.points[i as usize]);
             orient2d(&a, &b, &c) != Sign::Positive
         })
-        .map(|(f, _)| format!("f{f}"))
+        .map(|(f, _)| FaceId::new(f))
         .collect();
     if !bad.is_empty() {
-        return Err(invalid(format!("non-positive triangles: {}", list(&bad))));
+        return Err(invalid(PlanarDefect::NonPositive(Offenders(bad))));
     }
     Ok(np)
 }
@@ -220,34 +221,35 @@ fn kept_vertices(
     let mut image: HashMap<u32, u32> = HashMap::new();
     for (i, o) in out.origin.iter().enumerate() {
         if let Some(j) = *o {
-            let q = domain
-                .points
-                .get(j as usize)
-                .ok_or_else(|| invalid(format!("v{i} has origin v{j}, not an input vertex")))?;
+            let q = domain.points.get(j as usize).ok_or_else(|| {
+                invalid(PlanarDefect::UnknownOrigin {
+                    vertex: VertexId::new(i),
+                    origin: v(j),
+                })
+            })?;
             let p = out.points[i];
             if p.x.to_bits() != q.x.to_bits() || p.y.to_bits() != q.y.to_bits() {
-                return Err(invalid(format!(
-                    "v{i} (input v{j}) moved: ({}, {}) instead of ({}, {})",
-                    p.x, p.y, q.x, q.y
-                )));
+                return Err(invalid(PlanarDefect::Moved {
+                    vertex: VertexId::new(i),
+                    input: v(j),
+                    at: [p.x, p.y],
+                    expected: [q.x, q.y],
+                }));
             }
             if image.insert(j, i as u32).is_some() {
-                return Err(invalid(format!("input v{j} appears twice in the output")));
+                return Err(invalid(PlanarDefect::InputTwice(v(j))));
             }
         }
     }
     let mut kept: Vec<u32> = domain.boundary.clone();
     kept.extend(domain.constrained_edges.iter().flatten());
-    let missing: Vec<String> = kept
+    let missing: Vec<InputVertex> = kept
         .iter()
-        .filter(|v| !image.contains_key(v))
-        .map(|v| format!("input v{v}"))
+        .filter(|j| !image.contains_key(j))
+        .map(|&j| InputVertex(v(j)))
         .collect();
     if !missing.is_empty() {
-        return Err(invalid(format!(
-            "boundary/constrained vertices missing: {}",
-            list(&missing)
-        )));
+        return Err(invalid(PlanarDefect::KeptMissing(Offenders(missing))));
     }
     Ok(image)
 }
@@ -259,9 +261,10 @@ fn half_edges(out: &PlanarMesh) -> Result<HashMap<(u32, u32), u32>, InvariantErr
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             if he.insert((a, b), f as u32).is_some() {
-                return Err(invalid(format!(
-                    "half-edge (v{a}, v{b}) used twice (f{f}): non-manifold or inconsistent"
-                )));
+                return Err(invalid(PlanarDefect::HalfEdgeTwice {
+                    edge: edge(a, b),
+                    face: FaceId::new(f),
+                }));
             }
         }
     }
@@ -287,9 +290,10 @@ fn boundary_loop_kept(
         // Both are in `image` (checked above).
         let (ia, ib) = (image[&a], image[&b]);
         if !he.contains_key(&(ia, ib)) || he.contains_key(&(ib, ia)) {
-            return Err(invalid(format!(
-                "input boundary edge (v{a}, v{b}) is not a boundary edge (v{ia}, v{ib}) of the output"
-            )));
+            return Err(invalid(PlanarDefect::BoundaryEdgeLost {
+                input: edge(a, b),
+                output: edge(ia, ib),
+            }));
         }
         expected.push((ia, ib));
     }
@@ -300,13 +304,11 @@ fn boundary_loop_kept(
             .copied()
             .collect();
         extra.sort_unstable();
-        let names: Vec<String> = extra.iter().map(|(a, b)| format!("(v{a}, v{b})")).collect();
-        return Err(invalid(format!(
-            "output has {} boundary edges, input loop has {}; extra: {}",
-            boundary_he.len(),
-            expected.len(),
-            list(&names)
-        )));
+        return Err(invalid(PlanarDefect::ExtraBoundaryEdges {
+            output: boundary_he.len(),
+            input: expected.len(),
+            extra: Offenders(extra.iter().map(|&(a, b)| edge(a, b)).collect()),
+        }));
     }
     Ok((expected, boundary_he.len()))
 }
@@ -320,9 +322,10 @@ fn constrained_edges_kept(
     for &[a, b] in &domain.constrained_edges {
         let (ia, ib) = (image[&a], image[&b]);
         if !he.contains_key(&(ia, ib)) && !he.contains_key(&(ib, ia)) {
-            return Err(invalid(format!(
-                "constrained edge (v{a}, v{b}) missing (output v{ia}, v{ib})"
-            )));
+            return Err(invalid(PlanarDefect::ConstrainedEdgeMissing {
+                input: edge(a, b),
+                output: edge(ia, ib),
+            }));
         }
     }
     Ok(())
@@ -339,7 +342,7 @@ fn euler_disk(out: &PlanarMesh, np: usize, half_edges: usize) -> Result<(), Inva
         }
     }
     if let Some(i) = used.iter().position(|u| !u) {
-        return Err(invalid(format!("v{i} is not used by any triangle")));
+        return Err(invalid(PlanarDefect::UnusedVertex(VertexId::new(i))));
     }
     let n_edges = half_edges / 2;
     let chi = np as i64 - n_edges as i64 + out.triangles.len() as i64;
@@ -368,9 +371,10 @@ fn area_kept(poly: &[Point2<f64>], out: &PlanarMesh) -> Result<(), InvariantErro
     // Written so that a NaN area fails too.
     let area_ok = (a_out - a_poly).abs() <= 1e-9 * a_poly.abs();
     if !area_ok {
-        return Err(invalid(format!(
-            "total area {a_out} differs from the polygon's {a_poly}"
-        )));
+        return Err(invalid(PlanarDefect::Area {
+            area: a_out,
+            polygon: a_poly,
+        }));
     }
     Ok(())
 }
@@ -385,16 +389,13 @@ fn interior_inside(
     // (8) interior vertices strictly inside.
     let on_loop: std::collections::HashSet<u32> = boundary.iter().map(|e| e.0).collect();
     let slabs = PolygonSlabs::new(poly);
-    let outside: Vec<String> = (0..np as u32)
+    let outside: Vec<VertexId> = (0..np as u32)
         .filter(|i| !on_loop.contains(i))
         .filter(|&i| slabs.contains(&out.points[i as usize]) != Some(true))
-        .map(|i| format!("v{i}"))
+        .map(v)
         .collect();
     if !outside.is_empty() {
-        return Err(invalid(format!(
-            "interior vertices not strictly inside the polygon: {}",
-            list(&outside)
-        )));
+        return Err(invalid(PlanarDefect::Outside(Offenders(outside))));
     }
     Ok(())
 }
@@ -439,7 +440,15 @@ mod tests {
         m.points[2].x = 1.0 + f64::EPSILON;
         let e = certify_planar(&square(), &m);
         assert!(
-            matches!(e, Err(InvariantError::PlanarInvalid { reason }) if reason.contains("v2"))
+            matches!(
+                e,
+                Err(InvariantError::PlanarInvalid(PlanarDefect::Moved {
+                    vertex: VertexId(2),
+                    input: VertexId(2),
+                    ..
+                }))
+            ),
+            "{e:?}"
         );
     }
 
@@ -449,7 +458,11 @@ mod tests {
         let m = with_center(Point2::new(1.5, 0.5));
         let e = certify_planar(&square(), &m);
         assert!(
-            matches!(e, Err(InvariantError::PlanarInvalid { reason }) if reason.contains("non-positive"))
+            matches!(
+                e,
+                Err(InvariantError::PlanarInvalid(PlanarDefect::NonPositive(_)))
+            ),
+            "{e:?}"
         );
         // The center on the boundary: a degenerate triangle.
         let m = with_center(Point2::new(1.0, 0.5));
@@ -463,7 +476,16 @@ mod tests {
         m.triangles.pop();
         let e = certify_planar(&square(), &m);
         assert!(
-            matches!(e, Err(InvariantError::PlanarInvalid { reason }) if reason.contains("(v3, v0)"))
+            matches!(
+                e,
+                Err(InvariantError::PlanarInvalid(
+                    PlanarDefect::BoundaryEdgeLost {
+                        input: DirectedEdge(VertexId(3), VertexId(0)),
+                        ..
+                    }
+                ))
+            ),
+            "{e:?}"
         );
     }
 

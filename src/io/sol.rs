@@ -59,31 +59,134 @@ pub enum SolError {
         value: f64,
     },
     /// A token that does not parse, or a misplaced keyword.
-    #[error("{path}:{line}: {detail}")]
+    #[error("{path}:{line}: {defect}")]
     Parse {
         /// the file
         path: String,
         /// 1-based line number (ASCII) or 0 (binary)
         line: usize,
         /// what went wrong
-        detail: String,
+        defect: SolSyntax,
     },
     /// Dimension, solution type, field count or binary version we do not read.
-    #[error("{path}: unsupported: {detail}")]
+    #[error("{path}: unsupported: {what}")]
     UnsupportedType {
         /// the file
         path: String,
         /// what
-        detail: String,
+        what: SolUnsupported,
     },
     /// The file ends before all the data announced by its header.
-    #[error("{path}: truncated: {detail}")]
+    #[error("{path}: truncated: {missing}")]
     Truncated {
         /// the file
         path: String,
         /// what was missing
-        detail: String,
+        missing: SolTruncation,
     },
+}
+
+/// What does not parse in a `.sol` file ([`SolError::Parse`]).
+#[derive(Debug, Error)]
+pub enum SolSyntax {
+    /// The bytes are neither a binary `.solb` nor UTF-8 text.
+    #[error("neither binary nor UTF-8 text ({0})")]
+    NotText(#[source] std::str::Utf8Error),
+    /// An integer was expected.
+    #[error("expected {what} (an integer), found {found:?}")]
+    NotAnInteger {
+        /// what the integer is
+        what: &'static str,
+        /// the token found
+        found: String,
+    },
+    /// A number was expected.
+    #[error("expected a number, found {found:?}")]
+    NotANumber {
+        /// the token found
+        found: String,
+    },
+    /// A second `SolAtVertices` block.
+    #[error("second SolAtVertices block")]
+    SecondBlock,
+    /// A negative vertex count.
+    #[error("negative count {0}")]
+    NegativeCount(i64),
+    /// A field count outside 0..=64.
+    #[error("{0} solution fields")]
+    FieldCount(i64),
+    /// A token where a keyword was expected.
+    #[error("unexpected token {0:?} (expected a keyword: MeshVersionFormatted, Dimension, SolAtVertices, End)")]
+    UnexpectedToken(String),
+    /// A binary `SolAtVertices` header with a negative count or too many fields.
+    #[error("SolAtVertices header at byte {byte}: count {count}, {fields} fields")]
+    BinaryHeader {
+        /// the byte offset after the header
+        byte: usize,
+        /// the vertex count read
+        count: i64,
+        /// the field count read
+        fields: i64,
+    },
+}
+
+/// What a `.sol` file holds that we do not read ([`SolError::UnsupportedType`]).
+#[derive(Debug, Error)]
+pub enum SolUnsupported {
+    /// A dimension other than 3.
+    #[error("dimension {0} (only 3)")]
+    Dimension(i64),
+    /// Solution fields other than one scalar or one symmetric matrix.
+    #[error("solution types {types:?} at line {line} (only one field of type 1 or 3)")]
+    Types {
+        /// the types read
+        types: Vec<i64>,
+        /// the header's line (0 in a binary file)
+        line: usize,
+    },
+    /// A binary version other than 1, 2 or 3.
+    #[error("binary version {0} (1, 2 or 3)")]
+    BinaryVersion(i64),
+}
+
+/// What a truncated `.sol` file lacks ([`SolError::Truncated`]).
+#[derive(Debug, Error)]
+pub enum SolTruncation {
+    /// The text ends where a token was expected.
+    #[error("end of file where {0} was expected")]
+    Token(&'static str),
+    /// The text ends inside the values.
+    #[error("{need} values announced, {found} found (vertex v{vertex} incomplete)")]
+    Values {
+        /// values announced by the header
+        need: usize,
+        /// values found
+        found: usize,
+        /// the first incomplete vertex
+        vertex: usize,
+    },
+    /// The bytes end inside a word.
+    #[error("end of file at byte {byte} reading {what}")]
+    Word {
+        /// the byte offset of the word
+        byte: usize,
+        /// what the word is
+        what: &'static str,
+    },
+    /// The bytes end before the values.
+    #[error("{need} values announced, {left} bytes left for them")]
+    Bytes {
+        /// values announced by the header
+        need: usize,
+        /// bytes left in the file
+        left: usize,
+    },
+    /// No `SolAtVertices` block in a text file (read up to `line`).
+    #[error("no SolAtVertices block (read up to line {0})")]
+    NoBlockUpTo(usize),
+    /// No `SolAtVertices` block in a binary file.
+    #[error("no SolAtVertices block")]
+    NoBlock,
 }
 
 const KW_DIMENSION: i32 = 3;
@@ -166,15 +269,16 @@ fn check_header(
     if dim != 3 {
         return Err(SolError::UnsupportedType {
             path: p.to_string(),
-            detail: format!("dimension {dim} (only 3)"),
+            what: SolUnsupported::Dimension(dim),
         });
     }
     if types.len() != 1 || !(types[0] == TYPE_SCALAR || types[0] == TYPE_SYM_MATRIX) {
         return Err(SolError::UnsupportedType {
             path: p.to_string(),
-            detail: format!(
-                "solution types {types:?} at line {line} (only one field of type 1 or 3)"
-            ),
+            what: SolUnsupported::Types {
+                types: types.to_vec(),
+                line,
+            },
         });
     }
     if count != n_vertices {
@@ -191,7 +295,7 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
     let text = std::str::from_utf8(bytes).map_err(|e| SolError::Parse {
         path: p.to_string(),
         line: 0,
-        detail: format!("neither binary nor UTF-8 text ({e})"),
+        defect: SolSyntax::NotText(e),
     })?;
     // Tokens with their 1-based line; '#' starts a comment.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
@@ -200,10 +304,10 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
         l.split_whitespace().map(move |t| (i + 1, t))
     });
     let mut last_line = 1usize;
-    let parse_err = |line: usize, detail: String| SolError::Parse {
+    let parse_err = |line: usize, defect: SolSyntax| SolError::Parse {
         path: p.to_string(),
         line,
-        detail,
+        defect,
     };
     let mut dim = 3i64;
     let mut sol: Option<RawSol> = None;
@@ -213,7 +317,7 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
                 None => {
                     return Err(SolError::Truncated {
                         path: p.to_string(),
-                        detail: format!("end of file where {} was expected", $what),
+                        missing: SolTruncation::Token($what),
                     })
                 }
                 Some((line, t)) => {
@@ -221,7 +325,10 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
                     t.parse::<i64>().map_err(|_| {
                         parse_err(
                             line,
-                            format!("expected {} (an integer), found {t:?}", $what),
+                            SolSyntax::NotAnInteger {
+                                what: $what,
+                                found: t.to_string(),
+                            },
                         )
                     })?
                 }
@@ -236,15 +343,15 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
             dim = next_int!("the dimension");
         } else if tok.eq_ignore_ascii_case("SolAtVertices") {
             if sol.is_some() {
-                return Err(parse_err(line, "second SolAtVertices block".into()));
+                return Err(parse_err(line, SolSyntax::SecondBlock));
             }
             let count = next_int!("the number of vertices");
             if count < 0 {
-                return Err(parse_err(last_line, format!("negative count {count}")));
+                return Err(parse_err(last_line, SolSyntax::NegativeCount(count)));
             }
             let ntypes = next_int!("the number of solution fields");
             if !(0..=64).contains(&ntypes) {
-                return Err(parse_err(last_line, format!("{ntypes} solution fields")));
+                return Err(parse_err(last_line, SolSyntax::FieldCount(ntypes)));
             }
             let mut types = Vec::new();
             for _ in 0..ntypes {
@@ -257,16 +364,22 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
                 let Some((l, t)) = tokens.next() else {
                     return Err(SolError::Truncated {
                         path: p.to_string(),
-                        detail: format!(
-                            "{need} values announced, {k} found (vertex v{} incomplete)",
-                            k / values_per_vertex(kind)
-                        ),
+                        missing: SolTruncation::Values {
+                            need,
+                            found: k,
+                            vertex: k / values_per_vertex(kind),
+                        },
                     });
                 };
                 last_line = l;
-                let x = t
-                    .parse::<f64>()
-                    .map_err(|_| parse_err(l, format!("expected a number, found {t:?}")))?;
+                let x = t.parse::<f64>().map_err(|_| {
+                    parse_err(
+                        l,
+                        SolSyntax::NotANumber {
+                            found: t.to_string(),
+                        },
+                    )
+                })?;
                 values.push(x);
             }
             sol = Some(RawSol {
@@ -277,15 +390,12 @@ fn read_ascii(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolErr
         } else if tok.eq_ignore_ascii_case("End") {
             break;
         } else {
-            return Err(parse_err(
-                line,
-                format!("unexpected token {tok:?} (expected a keyword: MeshVersionFormatted, Dimension, SolAtVertices, End)"),
-            ));
+            return Err(parse_err(line, SolSyntax::UnexpectedToken(tok.to_string())));
         }
     }
     sol.ok_or_else(|| SolError::Truncated {
         path: p.to_string(),
-        detail: format!("no SolAtVertices block (read up to line {last_line})"),
+        missing: SolTruncation::NoBlockUpTo(last_line),
     })
 }
 
@@ -298,12 +408,15 @@ struct Cursor<'a> {
 }
 
 impl Cursor<'_> {
-    fn take<const N: usize>(&mut self, what: &str) -> Result<[u8; N], SolError> {
+    fn take<const N: usize>(&mut self, what: &'static str) -> Result<[u8; N], SolError> {
         let end = self.pos.checked_add(N).filter(|e| *e <= self.bytes.len());
         let Some(end) = end else {
             return Err(SolError::Truncated {
                 path: self.p.to_string(),
-                detail: format!("end of file at byte {} reading {what}", self.pos),
+                missing: SolTruncation::Word {
+                    byte: self.pos,
+                    what,
+                },
             });
         };
         let mut b = [0u8; N];
@@ -314,16 +427,16 @@ impl Cursor<'_> {
         }
         Ok(b)
     }
-    fn i32(&mut self, what: &str) -> Result<i64, SolError> {
+    fn i32(&mut self, what: &'static str) -> Result<i64, SolError> {
         Ok(i32::from_le_bytes(self.take::<4>(what)?) as i64)
     }
-    fn i64(&mut self, what: &str) -> Result<i64, SolError> {
+    fn i64(&mut self, what: &'static str) -> Result<i64, SolError> {
         Ok(i64::from_le_bytes(self.take::<8>(what)?))
     }
-    fn f32(&mut self, what: &str) -> Result<f64, SolError> {
+    fn f32(&mut self, what: &'static str) -> Result<f64, SolError> {
         Ok(f32::from_le_bytes(self.take::<4>(what)?) as f64)
     }
-    fn f64(&mut self, what: &str) -> Result<f64, SolError> {
+    fn f64(&mut self, what: &'static str) -> Result<f64, SolError> {
         Ok(f64::from_le_bytes(self.take::<8>(what)?))
     }
 }
@@ -340,7 +453,7 @@ fn read_binary(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolEr
     if !(1..=3).contains(&version) {
         return Err(SolError::UnsupportedType {
             path: p.to_string(),
-            detail: format!("binary version {version} (1, 2 or 3)"),
+            what: SolUnsupported::BinaryVersion(version),
         });
     }
     let mut dim = 3i64;
@@ -361,10 +474,11 @@ fn read_binary(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolEr
                     return Err(SolError::Parse {
                         path: p.to_string(),
                         line: 0,
-                        detail: format!(
-                            "SolAtVertices header at byte {}: count {count}, {ntypes} fields",
-                            c.pos
-                        ),
+                        defect: SolSyntax::BinaryHeader {
+                            byte: c.pos,
+                            count,
+                            fields: ntypes,
+                        },
                     });
                 }
                 let mut types = Vec::new();
@@ -377,10 +491,10 @@ fn read_binary(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolEr
                 if bytes.len() - c.pos < need * width {
                     return Err(SolError::Truncated {
                         path: p.to_string(),
-                        detail: format!(
-                            "{need} values announced, {} bytes left for them",
-                            bytes.len() - c.pos
-                        ),
+                        missing: SolTruncation::Bytes {
+                            need,
+                            left: bytes.len() - c.pos,
+                        },
                     });
                 }
                 let mut values = Vec::with_capacity(need);
@@ -408,7 +522,7 @@ fn read_binary(p: &str, bytes: &[u8], n_vertices: usize) -> Result<RawSol, SolEr
     }
     Err(SolError::Truncated {
         path: p.to_string(),
-        detail: "no SolAtVertices block".into(),
+        missing: SolTruncation::NoBlock,
     })
 }
 

@@ -3,7 +3,7 @@
 //! face and interpolating the three vertex tensors barycentrically,
 //! `M_v = b₀ M₀ + b₁ M₁ + b₂ M₂`. It is the one way later stages ask for the metric.
 
-use super::{curvature_metric, MetricError, MetricOptions};
+use super::{curvature_metric, MetricError, MetricOptions, SpdDefect};
 use crate::ids::FaceId;
 use crate::mesh::{SurfaceLocation, SurfaceProjector, TriMesh};
 use nalgebra::{Matrix2, Matrix3, Point3, Vector3};
@@ -80,7 +80,7 @@ pub fn validate_vertex_metric(
     if asym > SPD_RELATIVE_TOLERANCE * scale {
         return Err(MetricError::NotSpd {
             vertex,
-            detail: format!("not symmetric (max |m_ij − m_ji| = {asym:e})"),
+            defect: SpdDefect::NotSymmetric { asymmetry: asym },
         });
     }
     let sym = (m + m.transpose()) * 0.5;
@@ -90,10 +90,9 @@ pub fn validate_vertex_metric(
     if lmin < -SPD_RELATIVE_TOLERANCE * lmax {
         return Err(MetricError::NotSpd {
             vertex,
-            detail: format!(
-                "negative eigenvalue (eigenvalues {:e}, {:e}, {:e})",
-                eig[0], eig[1], eig[2]
-            ),
+            defect: SpdDefect::NegativeEigenvalue {
+                eigenvalues: [eig[0], eig[1], eig[2]],
+            },
         });
     }
     let nl = normal.norm();
@@ -110,21 +109,12 @@ pub fn validate_vertex_metric(
         if !(bmin > 0.0 && bmin > TANGENT_PD_RELATIVE_TOLERANCE * lmax) {
             // Positive but beyond the conditioning the predicates and the planar stage can
             // carry is not the same error as indefinite: say which.
-            let detail = match bmin > 0.0 {
-                true => format!(
-                    "positive definite on the tangent plane but conditioned beyond {:e}:1 \
-                     (eigenvalues there {:e}, {:e}; sizes differing by more than {:e} at one point)",
-                    1.0 / TANGENT_PD_RELATIVE_TOLERANCE,
-                    be[0],
-                    be[1],
-                    TANGENT_PD_RELATIVE_TOLERANCE.sqrt().recip()
-                ),
-                false => format!(
-                    "not positive definite on the tangent plane (eigenvalues there {:e}, {:e})",
-                    be[0], be[1]
-                ),
+            let eigenvalues = [be[0], be[1]];
+            let defect = match bmin > 0.0 {
+                true => SpdDefect::IllConditioned { eigenvalues },
+                false => SpdDefect::TangentIndefinite { eigenvalues },
             };
-            return Err(MetricError::NotSpd { vertex, detail });
+            return Err(MetricError::NotSpd { vertex, defect });
         }
     }
     Ok(())
@@ -182,9 +172,7 @@ impl MetricField {
             reference.positions.iter().map(to_parry).collect(),
             reference.index_triangles(),
         )
-        .map_err(|e| MetricError::Bvh {
-            detail: e.to_string(),
-        })?;
+        .map_err(MetricError::Bvh)?;
         let face_normals = reference
             .faces()
             .map(|f| reference.face_normal(f))

@@ -31,13 +31,13 @@ use thiserror::Error;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum MetricError {
     /// A tensor is not symmetric positive (semi-)definite on the tangent plane, or is so
-    /// badly conditioned there that it cannot be used (`detail` says which).
-    #[error("metric at vertex v{vertex} cannot be used: {detail}")]
+    /// badly conditioned there that it cannot be used (`defect` says which, with its numbers).
+    #[error("metric at vertex v{vertex} cannot be used: {defect}")]
     NotSpd {
         /// vertex index
         vertex: usize,
-        /// eigenvalues or other detail
-        detail: String,
+        /// what is wrong with the tensor
+        defect: SpdDefect,
     },
     /// A tensor has a NaN or infinite entry.
     #[error("metric at vertex v{vertex} has a NaN or infinite entry")]
@@ -57,10 +57,53 @@ pub enum MetricError {
     #[error("reference mesh: {0}")]
     Mesh(#[from] MeshError),
     /// The closest-point structure could not be built.
-    #[error("closest-point BVH: {detail}")]
-    Bvh {
-        /// parry's message
-        detail: String,
+    #[error("closest-point BVH: {0}")]
+    Bvh(#[source] parry3d_f64::shape::TriMeshBuilderError),
+}
+
+/// Why a tensor cannot be used as a metric ([`MetricError::NotSpd`]), with its numbers.
+#[derive(Debug, Error, Clone, Copy, PartialEq)]
+pub enum SpdDefect {
+    /// `m − mᵀ` is beyond [`field::SPD_RELATIVE_TOLERANCE`] of the largest entry.
+    #[error("not symmetric (max |m_ij − m_ji| = {asymmetry:e})")]
+    NotSymmetric {
+        /// max |m_ij − m_ji|
+        asymmetry: f64,
+    },
+    /// An eigenvalue of the symmetric part is negative.
+    #[error(
+        "negative eigenvalue (eigenvalues {:e}, {:e}, {:e})",
+        eigenvalues[0],
+        eigenvalues[1],
+        eigenvalues[2]
+    )]
+    NegativeEigenvalue {
+        /// the three eigenvalues
+        eigenvalues: [f64; 3],
+    },
+    /// The tensor restricted to the tangent plane is not positive definite.
+    #[error(
+        "not positive definite on the tangent plane (eigenvalues there {:e}, {:e})",
+        eigenvalues[0],
+        eigenvalues[1]
+    )]
+    TangentIndefinite {
+        /// the two eigenvalues on the tangent plane
+        eigenvalues: [f64; 2],
+    },
+    /// Positive definite on the tangent plane, but conditioned beyond what the predicates and
+    /// the planar stage can carry ([`field::TANGENT_PD_RELATIVE_TOLERANCE`]).
+    #[error(
+        "positive definite on the tangent plane but conditioned beyond {:e}:1 \
+         (eigenvalues there {:e}, {:e}; sizes differing by more than {:e} at one point)",
+        1.0 / field::TANGENT_PD_RELATIVE_TOLERANCE,
+        eigenvalues[0],
+        eigenvalues[1],
+        field::TANGENT_PD_RELATIVE_TOLERANCE.sqrt().recip()
+    )]
+    IllConditioned {
+        /// the two eigenvalues on the tangent plane
+        eigenvalues: [f64; 2],
     },
 }
 

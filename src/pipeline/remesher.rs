@@ -233,9 +233,9 @@ fn in_file_numbering(e: MetricError, map: &[Option<VertexId>]) -> MetricError {
             .unwrap_or(v)
     };
     match e {
-        MetricError::NotSpd { vertex, detail } => MetricError::NotSpd {
+        MetricError::NotSpd { vertex, defect } => MetricError::NotSpd {
             vertex: file_id(vertex),
-            detail,
+            defect,
         },
         MetricError::NonFinite { vertex } => MetricError::NonFinite {
             vertex: file_id(vertex),

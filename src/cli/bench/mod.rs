@@ -20,11 +20,12 @@ mod side_by_side;
 mod tools;
 
 use anyhow::{bail, ensure, Context};
-use conemesh::compare::process::error_line;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
+use std::rc::Rc;
 use std::time::Duration;
+use tools::{FieldError, ToolError};
 
 /// The extensions `conemesh` reads (see `conemesh::io`).
 const MESH_EXTENSIONS: [&str; 5] = ["obj", "off", "ply", "stl", "mesh"];
@@ -132,7 +133,7 @@ const TARGET_HAUSDORFF_REL: f64 = 0.01;
 /// One benchmark row.
 struct Row {
     name: String,
-    outcome: Result<Numbers, String>,
+    outcome: Result<Numbers, Rc<ToolError>>,
     /// The child's wall time, spawn to exit (`None`: it could not start, or timed out).
     wall: Option<f64>,
 }
@@ -173,22 +174,15 @@ impl Numbers {
     }
 
     /// The numbers of a `conemesh remesh --report` file.
-    fn from_report(json: &serde_json::Value) -> Result<Numbers, String> {
-        let get = |path: &[&str]| -> Result<&serde_json::Value, String> {
-            path.iter()
-                .try_fold(json, |v, k| v.get(k))
-                .ok_or_else(|| format!("the report has no `{}`", path.join(".")))
+    fn from_report(json: &serde_json::Value) -> Result<Numbers, FieldError> {
+        let get = |path: &'static [&'static str]| tools::field(json, "report", path);
+        let f = |path: &'static [&'static str]| -> Result<f64, FieldError> {
+            get(path)?.as_f64().ok_or(FieldError::NotNumber { path })
         };
-        let f = |path: &[&str]| -> Result<f64, String> {
-            get(path)?
-                .as_f64()
-                .ok_or_else(|| format!("`{}` is not a number", path.join(".")))
+        let u = |path: &'static [&'static str]| -> Result<u64, FieldError> {
+            get(path)?.as_u64().ok_or(FieldError::NotCount { path })
         };
-        let u = |path: &[&str]| -> Result<u64, String> {
-            get(path)?
-                .as_u64()
-                .ok_or_else(|| format!("`{}` is not a count", path.join(".")))
-        };
+        const FLIPS: &[&str] = &["eval", "flips"];
         Ok(Numbers {
             faces_in: u(&["run", "faces_in"])?,
             faces_out: u(&["run", "faces_out"])?,
@@ -198,10 +192,10 @@ impl Numbers {
             theta_min: f(&["eval", "output_quality", "theta_min"])?,
             theta_avg: f(&["eval", "output_quality", "theta_avg"])?,
             hausdorff_rel: f(&["eval", "distance", "hausdorff_rel"])?,
-            flips: get(&["eval", "flips"])?
+            flips: get(FLIPS)?
                 .as_array()
                 .map(|a| a.len())
-                .ok_or("`eval.flips` is not a list")?,
+                .ok_or(FieldError::NotList { path: FLIPS })?,
             seconds: f(&["seconds"])?,
             peak_mb: json.get("peak_rss_mib").and_then(|v| v.as_f64()),
             l_tar: f(&["run", "l_tar"])?,
@@ -451,7 +445,13 @@ impl Folder {
         }
         cmd.args(&self.remesh_args);
         let (outcome, wall) = match tools::run_timed(&mut cmd, self.timeout) {
-            Err(e) => (Err(format!("remesh {e}")), None),
+            Err(source) => (
+                Err(Rc::new(ToolError::NoExit {
+                    step: Some("remesh"),
+                    source,
+                })),
+                None,
+            ),
             Ok(child) => {
                 let mut log = child.stdout.clone();
                 log.extend_from_slice(&child.stderr);
@@ -459,19 +459,11 @@ impl Folder {
                 conemesh::io::write_bytes_atomic(&log_path, &log)
                     .with_context(|| format!("writing {}", log_path.display()))?;
                 let outcome = if child.status.success() {
-                    std::fs::read_to_string(&report)
-                        .map_err(|e| format!("reading {}: {e}", report.display()))
-                        .and_then(|s| {
-                            serde_json::from_str::<serde_json::Value>(&s)
-                                .map_err(|e| format!("{}: {e}", report.display()))
-                        })
-                        .and_then(|j| Numbers::from_report(&j))
+                    tools::read_json(&report)
+                        .and_then(|j| Ok(Numbers::from_report(&j)?))
+                        .map_err(Rc::new)
                 } else {
-                    Err(format!(
-                        "remesh failed ({}): {}",
-                        child.status,
-                        error_line(&String::from_utf8_lossy(&child.stderr))
-                    ))
+                    Err(Rc::new(ToolError::failed("remesh", &child)))
                 };
                 (outcome, Some(child.wall))
             }
@@ -492,7 +484,7 @@ fn same_bytes(a: &Path, b: &Path) -> bool {
 /// A further thread count's run of one mesh.
 struct ThreadRun {
     /// The run's own time (`remesh s`), or why it failed.
-    outcome: Result<f64, String>,
+    outcome: Result<f64, Rc<ToolError>>,
     /// Its output is byte for byte the tabled run's (`None`: one of them failed).
     same: Option<bool>,
 }
@@ -575,7 +567,7 @@ fn row_text(r: &Row) -> String {
             "| {} | - | - | - | - | - | - | - | - | {} | - | FAILED: {} |",
             cell(&r.name),
             seconds(r.wall),
-            cell(e)
+            cell(&e.to_string())
         ),
     }
 }
@@ -667,7 +659,7 @@ fn threads_section(s: &mut String, rows: &[MeshRows], counts: &[usize]) {
             let (time, speedup) = match (&base, &t.outcome) {
                 (Ok(b), Ok(o)) => (format!("{o:.2}"), format!("{:.2}", b / o)),
                 (_, Ok(o)) => (format!("{o:.2}"), "-".to_string()),
-                (_, Err(e)) => (format!("FAILED: {}", cell(e)), "-".to_string()),
+                (_, Err(e)) => (format!("FAILED: {}", cell(&e.to_string())), "-".to_string()),
             };
             let same = match t.same {
                 Some(true) => "yes",

@@ -9,14 +9,15 @@
 //! installed", which is not a failure.
 
 use super::tools::{
-    self, run_and_score, run_timed, Eval, Header, Outcome, Pair, ToolRun, MMG_ENV, MMG_NAME,
-    MMG_PROTOCOL,
+    self, run_and_score, run_timed, Eval, Header, Outcome, Pair, ToolError, ToolRun, MMG_ENV,
+    MMG_NAME, MMG_PROTOCOL,
 };
-use super::{error_line, Folder, Row};
+use super::{Folder, Row};
 use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::rc::Rc;
 
 /// MMG reads Medit `.mesh` only: any other input is converted first.
 pub(super) fn needs_conversion(input: &Path) -> bool {
@@ -32,13 +33,15 @@ pub(super) fn run_mesh(f: &Folder, mesh: &Path, name: &str, row: &Row) -> anyhow
         (Ok(n), Some(wall)) => (n, wall),
         (outcome, wall) => {
             let error = match outcome {
-                Err(e) => e.clone(),
-                Ok(_) => "remesh: no wall time".to_string(),
+                Err(e) => Rc::clone(e),
+                Ok(_) => Rc::new(ToolError::NoWall),
             };
             let mmg = match f.mmg {
                 None => Outcome::NotInstalled,
                 Some(_) => Outcome::Failed {
-                    error: format!("not run: conemesh failed, so there is no {name}-input.sol"),
+                    error: Rc::new(ToolError::NoMetric {
+                        name: name.to_string(),
+                    }),
                     wall: None,
                 },
             };
@@ -61,7 +64,7 @@ pub(super) fn run_mesh(f: &Folder, mesh: &Path, name: &str, row: &Row) -> anyhow
             score,
         },
         Err(error) => Outcome::Failed {
-            error,
+            error: Rc::new(error),
             wall: Some(wall),
         },
     };
@@ -72,7 +75,10 @@ pub(super) fn run_mesh(f: &Folder, mesh: &Path, name: &str, row: &Row) -> anyhow
     let mut log = Vec::new();
     let out = f.path(name, "-mmg.mesh");
     let mmg = match mmg_input(f, mesh, name, &mut log) {
-        Err(error) => Outcome::Failed { error, wall: None },
+        Err(error) => Outcome::Failed {
+            error: Rc::new(error),
+            wall: None,
+        },
         Ok(input) => {
             let mut cmd = Command::new(bin);
             cmd.arg("-in")
@@ -111,24 +117,23 @@ fn write_log(path: &Path, log: &[u8]) -> anyhow::Result<()> {
 
 /// MMG's input: `mesh` itself when it is a `.mesh`, else `conemesh convert MESH NAME.mesh`
 /// (the same vertices in the same order, so `NAME-input.sol` has one tensor per vertex).
-fn mmg_input(f: &Folder, mesh: &Path, name: &str, log: &mut Vec<u8>) -> Result<PathBuf, String> {
+fn mmg_input(f: &Folder, mesh: &Path, name: &str, log: &mut Vec<u8>) -> Result<PathBuf, ToolError> {
     if !needs_conversion(mesh) {
         return Ok(mesh.to_path_buf());
     }
     let converted = f.path(name, ".mesh");
     let mut cmd = Command::new(&f.exe);
     cmd.arg("convert").arg(mesh).arg(&converted);
-    let c = run_timed(&mut cmd, f.timeout).map_err(|e| format!("convert {e}"))?;
+    let c = run_timed(&mut cmd, f.timeout).map_err(|source| ToolError::NoExit {
+        step: Some("convert"),
+        source,
+    })?;
     log.extend_from_slice(b"--- conemesh convert ---\n");
     log.extend_from_slice(&c.stdout);
     log.extend_from_slice(&c.stderr);
     log.extend_from_slice(b"--- MMG ---\n");
     if !c.status.success() {
-        return Err(format!(
-            "convert failed ({}): {}",
-            c.status,
-            error_line(&String::from_utf8_lossy(&c.stderr))
-        ));
+        return Err(ToolError::failed("convert", &c));
     }
     Ok(converted)
 }

@@ -4,9 +4,10 @@
 
 use super::cell;
 use anyhow::ensure;
-use conemesh::compare::process::error_line;
+use conemesh::compare::process::{error_line, ChildError};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, ExitStatus};
+use std::rc::Rc;
 use std::time::Duration;
 
 /// MMG's surface remesher, looked up on PATH.
@@ -98,11 +99,137 @@ impl Header {
     }
 }
 
-pub(super) use conemesh::compare::process::Finished;
+pub(super) use conemesh::compare::process::{run_timed, Finished};
 
-/// [`conemesh::compare::process::run_timed`] with the error as text, as the rows hold it.
-pub(super) fn run_timed(cmd: &mut Command, timeout: Duration) -> Result<Finished, String> {
-    conemesh::compare::process::run_timed(cmd, timeout).map_err(|e| e.to_string())
+/// Why a tool's run, or its scoring, gave no numbers; a FAILED cell shows its message.
+#[derive(Debug, thiserror::Error)]
+pub(super) enum ToolError {
+    /// The child gave no exit status (`step` names it, except in the tool's own row).
+    #[error("{}{source}", step.map_or(String::new(), |s| format!("{s} ")))]
+    NoExit {
+        /// the child: `remesh`, `eval`, `convert`
+        step: Option<&'static str>,
+        /// why there is no exit status
+        source: ChildError,
+    },
+    /// The child exited with a failure.
+    #[error("{step} failed ({status}): {message}")]
+    Failed {
+        /// the child: the tool, `remesh`, `eval`, `convert`
+        step: &'static str,
+        /// its exit status
+        status: ExitStatus,
+        /// the line of its stderr that names the error
+        message: String,
+    },
+    /// The tool succeeded without writing its output.
+    #[error("{tool} exited without writing {}", output.display())]
+    NoOutput {
+        /// the tool
+        tool: &'static str,
+        /// the output it was asked for
+        output: PathBuf,
+    },
+    /// A report cannot be read.
+    #[error("reading {}: {source}", path.display())]
+    Read {
+        /// the report
+        path: PathBuf,
+        /// the OS error
+        source: std::io::Error,
+    },
+    /// A report is not JSON.
+    #[error("{}: {source}", path.display())]
+    Json {
+        /// the report
+        path: PathBuf,
+        /// the parser's error
+        source: serde_json::Error,
+    },
+    /// A report lacks a number.
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    /// MMG was not run: conemesh's run failed, so there is no metric for it.
+    #[error("not run: conemesh failed, so there is no {name}-input.sol")]
+    NoMetric {
+        /// the input's name
+        name: String,
+    },
+    /// conemesh's run has numbers but no wall time.
+    #[error("remesh: no wall time")]
+    NoWall,
+}
+
+impl ToolError {
+    /// The failure of a child that exited with `status`.
+    pub(super) fn failed(step: &'static str, f: &Finished) -> ToolError {
+        ToolError::Failed {
+            step,
+            status: f.status,
+            message: error_line(&String::from_utf8_lossy(&f.stderr)).to_string(),
+        }
+    }
+}
+
+/// A field a report (`which`: "report" or "eval report") lacks or holds in another type; `path`
+/// is its keys from the top.
+#[derive(Debug, thiserror::Error)]
+pub(super) enum FieldError {
+    /// No such field.
+    #[error("the {which} has no `{}`", path.join("."))]
+    Missing {
+        /// "report" or "eval report"
+        which: &'static str,
+        /// the keys
+        path: &'static [&'static str],
+    },
+    /// Not a number.
+    #[error("`{}` is not a number", path.join("."))]
+    NotNumber {
+        /// the keys
+        path: &'static [&'static str],
+    },
+    /// Not a count.
+    #[error("`{}` is not a count", path.join("."))]
+    NotCount {
+        /// the keys
+        path: &'static [&'static str],
+    },
+    /// Not a list.
+    #[error("`{}` is not a list", path.join("."))]
+    NotList {
+        /// the keys
+        path: &'static [&'static str],
+    },
+    /// Not a boolean.
+    #[error("`{}` is not a boolean", path.join("."))]
+    NotBool {
+        /// the keys
+        path: &'static [&'static str],
+    },
+}
+
+/// The field at `path` of `json`, a report called `which`.
+pub(super) fn field<'a>(
+    json: &'a serde_json::Value,
+    which: &'static str,
+    path: &'static [&'static str],
+) -> Result<&'a serde_json::Value, FieldError> {
+    path.iter()
+        .try_fold(json, |v, k| v.get(k))
+        .ok_or(FieldError::Missing { which, path })
+}
+
+/// A report read as JSON.
+pub(super) fn read_json(path: &Path) -> Result<serde_json::Value, ToolError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ToolError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|source| ToolError::Json {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// One tool's numbers on one case, from `conemesh eval --json`.
@@ -121,27 +248,23 @@ pub(super) struct Score {
 }
 
 impl Score {
-    pub(super) fn from_eval(json: &serde_json::Value) -> Result<Score, String> {
-        let get = |path: &[&str]| -> Result<&serde_json::Value, String> {
-            path.iter()
-                .try_fold(json, |v, k| v.get(k))
-                .ok_or_else(|| format!("the eval report has no `{}`", path.join(".")))
+    pub(super) fn from_eval(json: &serde_json::Value) -> Result<Score, FieldError> {
+        let get = |path: &'static [&'static str]| field(json, "eval report", path);
+        let f = |path: &'static [&'static str]| -> Result<f64, FieldError> {
+            get(path)?.as_f64().ok_or(FieldError::NotNumber { path })
         };
-        let f = |path: &[&str]| -> Result<f64, String> {
-            get(path)?
-                .as_f64()
-                .ok_or_else(|| format!("`{}` is not a number", path.join(".")))
-        };
-        let len = |path: &[&str]| -> Result<usize, String> {
+        let len = |path: &'static [&'static str]| -> Result<usize, FieldError> {
             get(path)?
                 .as_array()
                 .map(|a| a.len())
-                .ok_or_else(|| format!("`{}` is not a list", path.join(".")))
+                .ok_or(FieldError::NotList { path })
         };
+        const FACES: &[&str] = &["report", "output", "faces"];
+        const KEPT: &[&str] = &["report", "topology_kept"];
         Ok(Score {
-            faces: get(&["report", "output", "faces"])?
+            faces: get(FACES)?
                 .as_u64()
-                .ok_or("`report.output.faces` is not a count")?,
+                .ok_or(FieldError::NotCount { path: FACES })?,
             q_min: f(&["report", "output_quality", "q_min"])?,
             q_avg: f(&["report", "output_quality", "q_avg"])?,
             theta_min: f(&["report", "output_quality", "theta_min"])?,
@@ -151,9 +274,9 @@ impl Score {
             hausdorff_rel: f(&["report", "distance", "hausdorff_rel"])?,
             flips: len(&["report", "flips"])?,
             self_intersections: len(&["report", "self_intersections"])?,
-            topology_kept: get(&["report", "topology_kept"])?
+            topology_kept: get(KEPT)?
                 .as_bool()
-                .ok_or("`report.topology_kept` is not a boolean")?,
+                .ok_or(FieldError::NotBool { path: KEPT })?,
         })
     }
 }
@@ -163,7 +286,10 @@ pub(super) enum Outcome {
     /// No MMG binary was found.
     NotInstalled,
     /// The tool or its eval failed (`wall`: the tool's time when it ran to the end).
-    Failed { error: String, wall: Option<f64> },
+    Failed {
+        error: Rc<ToolError>,
+        wall: Option<f64>,
+    },
     /// Ran and scored; `own` is conemesh's own time from its report (no eval, no writing).
     Done {
         wall: f64,
@@ -223,7 +349,7 @@ pub(super) fn tool_row(name: &str, t: &ToolRun, ratio: Option<f64>) -> String {
         Outcome::Failed { error, wall } => format!(
             "| {name} | {} | FAILED: {} | - | - | - | - | - | - | - | {} | - | - |",
             t.tool,
-            cell(error),
+            cell(&error.to_string()),
             wall.map_or("-".to_string(), |w| format!("{w:.2}"))
         ),
         Outcome::Done {
@@ -258,36 +384,37 @@ pub(super) fn tool_row(name: &str, t: &ToolRun, ratio: Option<f64>) -> String {
 /// Run one tool that writes `output`, then score that output with `score`; the tool's and the
 /// scoring's stdout and stderr go to `log`. `own` is left `None` for the caller to fill.
 pub(super) fn run_and_score(
-    tool: &str,
+    tool: &'static str,
     cmd: &mut Command,
     output: &Path,
     timeout: Duration,
     log: &mut Vec<u8>,
-    score: impl FnOnce(&mut Vec<u8>) -> Result<Score, String>,
+    score: impl FnOnce(&mut Vec<u8>) -> Result<Score, ToolError>,
 ) -> Outcome {
-    let ran = run_timed(cmd, timeout).and_then(|f| {
-        log.extend_from_slice(&f.stdout);
-        log.extend_from_slice(&f.stderr);
-        if !f.status.success() {
-            return Err(format!(
-                "{tool} failed ({}): {}",
-                f.status,
-                error_line(&String::from_utf8_lossy(&f.stderr))
-            ));
-        }
-        if !output.is_file() {
-            return Err(format!(
-                "{tool} exited without writing {}",
-                output.display()
-            ));
-        }
-        Ok(f.wall)
-    });
+    let ran = run_timed(cmd, timeout)
+        .map_err(|source| ToolError::NoExit { step: None, source })
+        .and_then(|f| {
+            log.extend_from_slice(&f.stdout);
+            log.extend_from_slice(&f.stderr);
+            if !f.status.success() {
+                return Err(ToolError::failed(tool, &f));
+            }
+            if !output.is_file() {
+                return Err(ToolError::NoOutput {
+                    tool,
+                    output: output.to_path_buf(),
+                });
+            }
+            Ok(f.wall)
+        });
     match ran {
-        Err(error) => Outcome::Failed { error, wall: None },
+        Err(error) => Outcome::Failed {
+            error: Rc::new(error),
+            wall: None,
+        },
         Ok(wall) => match score(log) {
             Err(error) => Outcome::Failed {
-                error,
+                error: Rc::new(error),
                 wall: Some(wall),
             },
             Ok(score) => Outcome::Done {
@@ -311,7 +438,7 @@ pub(super) struct Eval<'a> {
 }
 
 impl Eval<'_> {
-    pub fn score(&self, output: &Path, json: &Path, log: &mut Vec<u8>) -> Result<Score, String> {
+    pub fn score(&self, output: &Path, json: &Path, log: &mut Vec<u8>) -> Result<Score, ToolError> {
         let mut cmd = Command::new(self.exe);
         cmd.arg("eval")
             .arg("--input")
@@ -322,22 +449,17 @@ impl Eval<'_> {
             cmd.arg("--metric").arg(m);
         }
         cmd.args(["--ltar", &self.ltar, "--json"]).arg(json);
-        let f = run_timed(&mut cmd, self.timeout).map_err(|e| format!("eval {e}"))?;
+        let f = run_timed(&mut cmd, self.timeout).map_err(|source| ToolError::NoExit {
+            step: Some("eval"),
+            source,
+        })?;
         log.extend_from_slice(b"\n--- conemesh eval ---\n");
         log.extend_from_slice(&f.stdout);
         log.extend_from_slice(&f.stderr);
         if !f.status.success() {
-            return Err(format!(
-                "eval failed ({}): {}",
-                f.status,
-                error_line(&String::from_utf8_lossy(&f.stderr))
-            ));
+            return Err(ToolError::failed("eval", &f));
         }
-        let text = std::fs::read_to_string(json)
-            .map_err(|e| format!("reading {}: {e}", json.display()))?;
-        let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", json.display()))?;
-        Score::from_eval(&value)
+        Ok(Score::from_eval(&read_json(json)?)?)
     }
 }
 
