@@ -43,6 +43,8 @@ pub struct ImproveOptions {
     pub rings: usize,
     /// At most this many patches over all passes (default: no bound beyond the passes).
     pub max_patches: Option<usize>,
+    /// What a patch's candidate must not lower (default [`Bottom::QualityAndAngles`]).
+    pub bottom: Bottom,
     /// The planar updates (Eq. 5-6); their defaults, but 12 halvings of the line search
     /// (30 cost 20 % more for the same result on the shared meshes).
     pub planar: Eq5Options,
@@ -56,6 +58,7 @@ impl Default for ImproveOptions {
             passes: 3,
             rings: 2,
             max_patches: None,
+            bottom: Bottom::QualityAndAngles,
             planar: Eq5Options {
                 line_search: 12,
                 ..Eq5Options::default()
@@ -96,6 +99,18 @@ impl ImproveOptions {
     }
 }
 
+/// What Algorithm 2's acceptance test keeps from falling, besides ranking the candidate's
+/// smallest angles leximin against the faces it replaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Bottom {
+    /// Neither the smallest metric quality q nor the smallest angle (registry name
+    /// `q-angles`).
+    QualityAndAngles,
+    /// The smallest angle only: a candidate that opens a small angle by making another face
+    /// more obtuse, and so lowers q_min, is taken (`angles`).
+    Angles,
+}
+
 impl ImproveOptions {
     /// The face is to be improved: q or its smallest angle below its threshold.
     pub fn is_bad(&self, t: &crate::quality::TriangleQuality) -> bool {
@@ -130,14 +145,15 @@ impl Improver for Algorithm2 {
             options: o.planar.clone(),
         };
         let mut counts = ImproverCounts::default();
-        let mut bad_before = usize::MAX;
+        let mut before: Option<Progress> = None;
         while counts.passes < o.passes {
-            let bad: Vec<bool> = run.face_qualities().iter().map(|t| o.is_bad(t)).collect();
-            let n_bad = bad.iter().filter(|b| **b).count();
-            if n_bad == 0 || n_bad >= bad_before {
+            let qualities = run.face_qualities();
+            let bad: Vec<bool> = qualities.iter().map(|t| o.is_bad(t)).collect();
+            let now = Progress::of(&qualities, &bad);
+            if now.bad == 0 || before.is_some_and(|b| !now.beats(&b)) {
                 break;
             }
-            bad_before = n_bad;
+            before = Some(now);
             // Each pass reaches one ring farther: the faces still bad after a pass are those
             // whose patch was too small to move their vertices (they sat on its boundary).
             let widened = stages.patches.widened(o.rings + counts.passes);
@@ -148,7 +164,7 @@ impl Improver for Algorithm2 {
             };
             counts.passes += 1;
             let budget = o.max_patches.map(|m| m.saturating_sub(counts.patches));
-            let pass = run.patch_pass(pass_stages, &bad, budget, &better_at_the_bottom, rng)?;
+            let pass = run.patch_pass(pass_stages, &bad, budget, &|old, new| better_at_the_bottom(o.bottom, old, new), rng)?;
             counts.patches += pass.patches;
             counts.rejected += pass.rejected;
             if pass.budget_exhausted {
@@ -157,6 +173,32 @@ impl Improver for Algorithm2 {
             }
         }
         Ok(counts)
+    }
+}
+
+/// Where a pass of Algorithm 2 left the mesh: the faces still to improve, and the smallest
+/// angle.
+#[derive(Clone, Copy, Debug)]
+struct Progress {
+    bad: usize,
+    theta_min: f64,
+}
+
+impl Progress {
+    fn of(qualities: &[TriangleQuality], bad: &[bool]) -> Progress {
+        Progress {
+            bad: bad.iter().filter(|b| **b).count(),
+            theta_min: qualities
+                .iter()
+                .map(|t| t.min_angle())
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+
+    /// Fewer faces to improve, or a larger smallest angle (a pass whose splits cut a cap into
+    /// faces still under the angle threshold has more of them, and better).
+    fn beats(&self, before: &Progress) -> bool {
+        self.bad < before.bad || self.theta_min > before.theta_min
     }
 }
 
@@ -171,7 +213,7 @@ impl Improver for Algorithm2 {
 /// cylinder-axial30). The planar updates lower the energy in the plane; lifted across a
 /// crease or a strongly curved part a move can still make a worse triangle on the surface,
 /// which is refused.
-fn better_at_the_bottom(old: &[TriangleQuality], new: &[TriangleQuality]) -> bool {
+fn better_at_the_bottom(bottom: Bottom, old: &[TriangleQuality], new: &[TriangleQuality]) -> bool {
     let q_min = |ts: &[TriangleQuality]| ts.iter().map(|t| t.q).fold(f64::INFINITY, f64::min);
     let angles = |ts: &[TriangleQuality]| {
         let mut a: Vec<f64> = ts.iter().map(|t| t.min_angle()).collect();
@@ -179,8 +221,9 @@ fn better_at_the_bottom(old: &[TriangleQuality], new: &[TriangleQuality]) -> boo
         a
     };
     let (a_old, a_new) = (angles(old), angles(new));
-    // Fewer faces: the planar updates' edge collapses; never more.
-    if new.len() > old.len() || new.is_empty() || q_min(new) < q_min(old) || a_new[0] < a_old[0] {
+    // Fewer faces (the planar updates' edge collapses) or more (their splits).
+    let q_guard = bottom == Bottom::QualityAndAngles;
+    if new.is_empty() || (q_guard && q_min(new) < q_min(old)) || a_new[0] < a_old[0] {
         return false;
     }
     a_new
@@ -225,30 +268,35 @@ mod tests {
         let old = [t(10.0, 0.3), t(20.0, 0.5), t(40.0, 0.9)];
         // The worst face unchanged (on the patch boundary), the next one raised: accepted.
         assert!(better_at_the_bottom(
+            Bottom::QualityAndAngles,
             &old,
             &[t(10.0, 0.3), t(30.0, 0.7), t(40.0, 0.9)]
         ));
         // The bottom raised.
         assert!(better_at_the_bottom(
+            Bottom::QualityAndAngles,
             &old,
             &[t(12.0, 0.3), t(15.0, 0.5), t(40.0, 0.9)]
         ));
         // Identical: refused (nothing gained).
-        assert!(!better_at_the_bottom(&old, &old));
+        assert!(!better_at_the_bottom(Bottom::QualityAndAngles, &old, &old));
         // The smallest angle falls, or q_min falls, though the rest rises: refused.
         assert!(!better_at_the_bottom(
+            Bottom::QualityAndAngles,
             &old,
             &[t(9.0, 0.4), t(50.0, 0.9), t(50.0, 0.9)]
         ));
         assert!(!better_at_the_bottom(
+            Bottom::QualityAndAngles,
             &old,
             &[t(10.0, 0.2), t(50.0, 0.9), t(50.0, 0.9)]
         ));
         // The second angle falls while the third rises: refused (leximin, not the sum).
         assert!(!better_at_the_bottom(
+            Bottom::QualityAndAngles,
             &old,
             &[t(10.0, 0.3), t(19.0, 0.5), t(60.0, 1.0)]
         ));
-        assert!(!better_at_the_bottom(&old, &[]));
+        assert!(!better_at_the_bottom(Bottom::QualityAndAngles, &old, &[]));
     }
 }

@@ -37,7 +37,7 @@ mod relocate;
 
 mod registry;
 
-pub use algorithm2::{Algorithm2, ImproveOptions};
+pub use algorithm2::{Algorithm2, Bottom, ImproveOptions};
 pub use eq5::{Eq5Options, Eq5Updates, FlipRule, Target};
 pub use flips::connectivity_update;
 pub(crate) use geometry::point_triangle_distance;

@@ -4,7 +4,7 @@
 //! them, in order ([`crate::pipeline::Stages::improvers`]); the default list is every row of
 //! [`IMPROVERS`], in order.
 
-use super::{Algorithm2, FlipRule, ImproveOptions, Improver, SurfacePasses, Target};
+use super::{Algorithm2, Bottom, FlipRule, ImproveOptions, Improver, SurfacePasses, Target};
 use crate::registry::{optional, BadValue, Entry, MetricSizes, OptionDoc, Params, RegistryError};
 
 impl crate::registry::Stage for dyn Improver {
@@ -100,6 +100,16 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
                 doc: "collapse the shortest edge of a triangle whose smallest angle is below this (degrees, [0, 60); 0: none) when that raises the smallest angle around it",
                 default: |_| ImproveOptions::default().planar.collapse_below_deg.to_string(),
             },
+            OptionDoc {
+                name: "bottom",
+                doc: "what a patch must not lower: q-angles (q_min and θ_min) or angles (θ_min only)",
+                default: |_| bottom_name(ImproveOptions::default().bottom).to_string(),
+            },
+            OptionDoc {
+                name: "split",
+                doc: "split the longest edge of an obtuse triangle whose smallest angle is below this (degrees, [0, 60); 0: none) when that raises the smallest angle around it",
+                default: |_| ImproveOptions::default().planar.split_below_deg.to_string(),
+            },
         ],
         build: eq5,
     },
@@ -111,6 +121,13 @@ pub fn improver(name: &str, params: Params) -> Result<Box<dyn Improver>, Registr
 }
 
 /// The option value of a flip rule.
+fn bottom_name(b: Bottom) -> &'static str {
+    match b {
+        Bottom::QualityAndAngles => "q-angles",
+        Bottom::Angles => "angles",
+    }
+}
+
 fn flip_rule_name(r: FlipRule) -> &'static str {
     match r {
         FlipRule::Energy => "energy",
@@ -167,6 +184,12 @@ fn eq5(p: &mut Params, _: MetricSizes) -> Result<Box<dyn Improver>, BadValue> {
             .find(|x| flip_rule_name(*x) == r)
             .ok_or_else(|| BadValue::new("flips", &r, "energy or max-min"))?;
     }
+    if let Some(b) = p.take::<String>("bottom", "q-angles or angles")? {
+        o.bottom = [Bottom::QualityAndAngles, Bottom::Angles]
+            .into_iter()
+            .find(|x| bottom_name(*x) == b)
+            .ok_or_else(|| BadValue::new("bottom", &b, "q-angles or angles"))?;
+    }
     if let Some(t) = p.take::<String>("target", "own-area or length")? {
         o.planar.target = [Target::OwnArea, Target::Length]
             .into_iter()
@@ -186,6 +209,11 @@ fn eq5(p: &mut Params, _: MetricSizes) -> Result<Box<dyn Improver>, BadValue> {
         (0.0..60.0).contains(&a)
     })? {
         o.planar.collapse_below_deg = a;
+    }
+    if let Some(a) = p.take_checked("split", "an angle in [0, 60) degrees", |a: f64| {
+        (0.0..60.0).contains(&a)
+    })? {
+        o.planar.split_below_deg = a;
     }
     Ok(Box::new(Algorithm2 { options: o }))
 }
