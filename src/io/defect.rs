@@ -5,7 +5,8 @@
 use crate::ids::VertexId;
 use thiserror::Error;
 
-/// What a token should have been ([`Syntax::Expected`], [`Truncation::Token`]).
+/// What kind of value a token should have been ([`Syntax::Expected`],
+/// [`Syntax::ElementValue`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Want {
@@ -15,10 +16,6 @@ pub enum Want {
     Integer,
     /// A non-negative count.
     Count,
-    /// The keyword named.
-    Keyword(&'static str),
-    /// One of the keywords named.
-    Keywords(&'static [&'static str]),
 }
 
 impl std::fmt::Display for Want {
@@ -27,16 +24,6 @@ impl std::fmt::Display for Want {
             Want::Number => f.write_str("a number"),
             Want::Integer => f.write_str("an integer"),
             Want::Count => f.write_str("a count"),
-            Want::Keyword(k) => write!(f, "`{k}`"),
-            Want::Keywords(ks) => {
-                for (i, k) in ks.iter().enumerate() {
-                    if i > 0 {
-                        f.write_str(" or ")?;
-                    }
-                    write!(f, "`{k}`")?;
-                }
-                Ok(())
-            }
         }
     }
 }
@@ -65,11 +52,26 @@ pub enum Syntax {
     /// A file that must be UTF-8 text throughout is not.
     #[error("not UTF-8 text")]
     NotUtf8,
-    /// Another token where a number, a count or a keyword was expected.
+    /// Another token where a number or a count was expected.
     #[error("expected {expected}, found `{found}`")]
     Expected {
         /// what was expected
         expected: Want,
+        /// the token found
+        found: String,
+    },
+    /// Another token where a keyword was expected.
+    #[error("expected `{keyword}`, found `{found}`")]
+    ExpectedKeyword {
+        /// the keyword
+        keyword: &'static str,
+        /// the token found
+        found: String,
+    },
+    /// Inside an ASCII STL solid, another token where a facet or the solid's end should
+    /// start.
+    #[error("expected `facet` or `endsolid`, found `{found}`")]
+    NotAFacet {
         /// the token found
         found: String,
     },
@@ -251,11 +253,11 @@ pub enum Truncation {
         /// the count its header claims
         claimed: u64,
     },
-    /// The file ends where a token was expected.
-    #[error("file ends where {expected} was expected (line {line})")]
-    Token {
-        /// what was expected
-        expected: Want,
+    /// The file ends where a keyword was expected.
+    #[error("file ends where `{keyword}` was expected (line {line})")]
+    Keyword {
+        /// the keyword
+        keyword: &'static str,
         /// the last line of the file
         line: usize,
     },

@@ -474,7 +474,9 @@ fn check_attributes(mesh: &TriMesh, attrs: &MeshAttributes, path: &str) -> Resul
             }));
         }
         if name.is_empty() || name.contains(char::is_whitespace) {
-            return Err(bad(AttributeProblem::FacePropertyName { name: name.clone() }));
+            return Err(bad(AttributeProblem::FacePropertyName {
+                name: name.clone(),
+            }));
         }
     }
     if let Some(c) = &attrs.face_colors {
@@ -492,7 +494,10 @@ fn check_attributes(mesh: &TriMesh, attrs: &MeshAttributes, path: &str) -> Resul
                 vertices: mesh.n_vertices(),
             }));
         }
-        if let Some(v) = uv.iter().position(|q| !(q.x.is_finite() && q.y.is_finite())) {
+        if let Some(v) = uv
+            .iter()
+            .position(|q| !(q.x.is_finite() && q.y.is_finite()))
+        {
             return Err(bad(AttributeProblem::NonFiniteUv {
                 vertex: crate::ids::VertexId(v as u32),
             }));

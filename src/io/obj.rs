@@ -4,9 +4,7 @@
 //! comments may hold bytes that are not UTF-8.
 
 use super::text::{as_text_with_names, float, int, short};
-use super::{
-    build_mesh, uv_per_vertex, IoError, LoadedMesh, MeshAttributes, RawFaces, Syntax,
-};
+use super::{build_mesh, uv_per_vertex, IoError, LoadedMesh, MeshAttributes, RawFaces, Syntax};
 use crate::mesh::TriMesh;
 use nalgebra::{Point2, Point3};
 use std::io::Write;

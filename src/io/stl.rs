@@ -5,7 +5,7 @@
 //! with `solid`. Binary STL holds `f32`: writing rounds each coordinate to the nearest `f32`.
 
 use super::text::{as_text, float, short, Tokens};
-use super::{build_mesh, IoError, LoadedMesh, RawFaces, Syntax, Truncation, Want, WriteOptions};
+use super::{build_mesh, IoError, LoadedMesh, RawFaces, Syntax, Truncation, WriteOptions};
 use crate::mesh::TriMesh;
 use nalgebra::Point3;
 use std::collections::HashMap;
@@ -169,19 +169,20 @@ fn read_ascii(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
             w.facet(c, vl, path)?;
             next = t.next();
         } else {
-            let expected = if in_solid {
-                Want::Keywords(&["facet", "endsolid"])
+            let found = short(tok);
+            let defect = if in_solid {
+                Syntax::NotAFacet { found }
             } else {
-                Want::Keyword("solid")
+                Syntax::ExpectedKeyword {
+                    keyword: "solid",
+                    found,
+                }
             };
             return Err(IoError::Parse {
                 path: path.to_string(),
                 format: F,
                 line: l,
-                defect: Syntax::Expected {
-                    expected,
-                    found: short(tok),
-                },
+                defect,
             });
         }
     }
@@ -209,16 +210,16 @@ fn expect(t: &mut Tokens, word: &'static str, path: &str) -> Result<usize, IoErr
             path: path.to_string(),
             format: F,
             line: l,
-            defect: Syntax::Expected {
-                expected: Want::Keyword(word),
+            defect: Syntax::ExpectedKeyword {
+                keyword: word,
                 found: short(tok),
             },
         }),
         None => Err(IoError::Truncated {
             path: path.to_string(),
             format: F,
-            missing: Truncation::Token {
-                expected: Want::Keyword(word),
+            missing: Truncation::Keyword {
+                keyword: word,
                 line: t.last_line,
             },
         }),

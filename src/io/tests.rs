@@ -571,8 +571,8 @@ fn defects_print_what_is_wrong() {
             &e,
             IoError::Parse {
                 line: 5,
-                defect: Syntax::Expected {
-                    expected: Want::Keyword("vertex"),
+                defect: Syntax::ExpectedKeyword {
+                    keyword: "vertex",
                     found,
                 },
                 ..
@@ -585,7 +585,10 @@ fn defects_print_what_is_wrong() {
         "t:5: STL parse error: expected `vertex`, found `endsolid`"
     );
     let e = rd("solid x\nfacet normal 0 0 1\nsolid\n", Format::Stl).unwrap_err();
-    assert!(e.to_string().ends_with("expected `outer`, found `solid`"), "{e}");
+    assert!(
+        e.to_string().ends_with("expected `outer`, found `solid`"),
+        "{e}"
+    );
     let e = rd("solid x\nvertex\n", Format::Stl).unwrap_err();
     assert_eq!(
         e.to_string(),
