@@ -20,12 +20,12 @@ pub enum StitchError {
     #[error("patch face {0} is out of range or repeated")]
     BadFace(FaceId),
     /// A replacement triangle refers to a vertex that does not exist.
-    #[error("replacement triangle {triangle} refers to missing vertex {vertex}")]
+    #[error("replacement triangle {triangle} refers to missing vertex {vertex:?}")]
     BadVertex {
         /// index in the replacement list
         triangle: usize,
         /// the vertex reference
-        vertex: String,
+        vertex: PatchVertex,
     },
 }
 
@@ -171,7 +171,7 @@ pub fn stitch_all(
                     other => {
                         return Err(StitchError::BadVertex {
                             triangle: i,
-                            vertex: format!("{other:?}"),
+                            vertex: other,
                         })
                     }
                 };
@@ -272,7 +272,10 @@ mod tests {
         };
         assert!(matches!(
             stitch(&mut w, &[FaceId(0)], &bad),
-            Err(StitchError::BadVertex { triangle: 0, .. })
+            Err(StitchError::BadVertex {
+                triangle: 0,
+                vertex: PatchVertex::New(0)
+            })
         ));
         assert_eq!(
             stitch(&mut w, &[FaceId(0), FaceId(0)], &Replacement::default()),

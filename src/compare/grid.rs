@@ -80,13 +80,13 @@ pub enum PictureError {
     /// `conemesh render` gave no exit status.
     #[error("render {0}")]
     Child(#[source] Arc<ChildError>),
-    /// `conemesh render` failed; `message` is the line of its stderr that names the error.
-    #[error("render {status}: {message}")]
+    /// `conemesh render` failed; `stderr_line` is the line of its stderr that names the error.
+    #[error("render {status}: {stderr_line}")]
     Failed {
         /// its exit status
         status: ExitStatus,
-        /// the line of its stderr that names the error
-        message: String,
+        /// the line of its stderr that names the error (the child's text, as it wrote it)
+        stderr_line: String,
     },
     /// `conemesh render` succeeded without writing the picture.
     #[error("render wrote no picture")]
@@ -370,7 +370,7 @@ impl Grid {
         if !f.status.success() {
             return Err(PictureError::Failed {
                 status: f.status,
-                message: error_line(&String::from_utf8_lossy(&f.stderr)).to_string(),
+                stderr_line: error_line(&String::from_utf8_lossy(&f.stderr)).to_string(),
             });
         }
         if !dir.join(&pic).is_file() {

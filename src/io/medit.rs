@@ -5,7 +5,9 @@
 //! the face attribute `ref` when any is non-zero, and written from the first face attribute.
 
 use super::text::{as_text, count, float, int, short, Tokens};
-use super::{build_mesh, check_claim, IoError, LoadedMesh, MeshAttributes, RawFaces};
+use super::{
+    build_mesh, check_claim, IoError, LoadedMesh, MeshAttributes, RawFaces, Syntax, Truncation,
+};
 use crate::mesh::TriMesh;
 use nalgebra::Point3;
 use std::io::Write;
@@ -43,16 +45,22 @@ fn record_tokens(key: &str, d: usize) -> Option<usize> {
 pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let text = as_text(bytes, path, F)?;
     let mut t = Tokens::new(text);
-    let parse = |line: usize, message: String| IoError::Parse {
+    let parse = |line: usize, defect: Syntax| IoError::Parse {
         path: path.to_string(),
         format: F,
         line,
-        message,
+        defect,
     };
-    let trunc = |what: &str, line: usize| IoError::Truncated {
+    let trunc = |missing: Truncation| IoError::Truncated {
         path: path.to_string(),
         format: F,
-        message: format!("file ends inside {what} (line {line})"),
+        missing,
+    };
+    let in_section = |section: &str, line: usize| {
+        trunc(Truncation::InsideSection {
+            section: short(section),
+            line,
+        })
     };
     let Some((l0, first)) = t.next() else {
         return Err(IoError::Empty {
@@ -69,7 +77,7 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     }
     let _version = match t.next() {
         Some((l, tok)) => int(tok, l, path, F)?,
-        None => return Err(trunc("the header", l0)),
+        None => return Err(trunc(Truncation::InsideHeader { line: l0 })),
     };
     let mut dim = 3;
     let mut positions: Vec<Point3<f64>> = Vec::new();
@@ -82,25 +90,30 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
             break;
         }
         if key == "dimension" {
-            let (dl, d) = t.next().ok_or_else(|| trunc("`Dimension`", l))?;
+            let (dl, d) = t.next().ok_or_else(|| {
+                trunc(Truncation::InsideKeyword {
+                    keyword: "Dimension",
+                    line: l,
+                })
+            })?;
             dim = match int(d, dl, path, F)? {
                 2 => 2,
                 3 => 3,
-                d => return Err(parse(dl, format!("dimension {d} (2 or 3 expected)"))),
+                d => return Err(parse(dl, Syntax::Dimension(d))),
             };
             continue;
         }
         let Some(k) = record_tokens(&key, dim) else {
-            return Err(parse(l, format!("unknown section `{}`", short(tok))));
+            return Err(parse(l, Syntax::UnknownSection { found: short(tok) }));
         };
-        let (cl, c) = t.next().ok_or_else(|| trunc(tok, l))?;
+        let (cl, c) = t.next().ok_or_else(|| in_section(tok, l))?;
         let n = count(c, cl, path, F)?;
         // Each record takes at least k tokens of 2 bytes.
         check_claim(path, F, "records", n, 2 * k as u64, bytes.len() + 1)?;
         let mut rec = [""; 9];
         for _ in 0..n {
             for slot in rec.iter_mut().take(k) {
-                *slot = t.next().ok_or_else(|| trunc(tok, t.last_line))?.1;
+                *slot = t.next().ok_or_else(|| in_section(tok, t.last_line))?.1;
             }
             let rl = t.last_line;
             match key.as_str() {

@@ -7,6 +7,7 @@
 //! element. Readers build a [`TriMesh`] through its validating constructor; whether the mesh is
 //! manifold or consistently oriented is not the reader's business (that is `check`).
 
+mod defect;
 mod medit;
 mod obj;
 mod off;
@@ -19,6 +20,7 @@ pub mod sol;
 mod stl;
 mod text;
 
+pub use defect::{AttributeProblem, Syntax, Truncation, Unread, Want};
 pub use outputs::{Outputs, TEMP_PREFIX};
 pub use polygon::PolygonProblem;
 
@@ -90,7 +92,7 @@ pub enum IoError {
         found: String,
     },
     /// Malformed text or header.
-    #[error("{path}{}: {format} parse error: {message}", loc(.line))]
+    #[error("{path}{}: {format} parse error: {defect}", loc(.line))]
     Parse {
         /// the file
         path: String,
@@ -99,17 +101,17 @@ pub enum IoError {
         /// 1-based line (0 when the format is binary)
         line: usize,
         /// what is wrong
-        message: String,
+        defect: Syntax,
     },
     /// The file ends before the data its header announced.
-    #[error("{path}: truncated {format} file: {message}")]
+    #[error("{path}: truncated {format} file: {missing}")]
     Truncated {
         /// the file
         path: String,
         /// format name
         format: &'static str,
         /// what was expected and what was found
-        message: String,
+        missing: Truncation,
     },
     /// A header claims more elements than a `u32` id can name (a file claiming more than it
     /// can hold, but fewer than that, is [`IoError::Truncated`]).
@@ -202,7 +204,7 @@ pub enum IoError {
         /// format name
         format: &'static str,
         /// the unsupported feature
-        what: String,
+        what: Unread,
     },
     /// The file holds no faces.
     #[error("{path}: {format} file has no faces")]
@@ -213,12 +215,12 @@ pub enum IoError {
         format: &'static str,
     },
     /// Attributes handed to a writer do not match the mesh.
-    #[error("{path}: bad attribute: {message}")]
+    #[error("{path}: bad attribute: {problem}")]
     BadAttribute {
         /// the file
         path: String,
         /// what does not match
-        message: String,
+        problem: AttributeProblem,
     },
     /// The mesh arrays are invalid (a writer refuses to write them).
     #[error("{path}: {source}")]
@@ -459,41 +461,46 @@ fn mesh_writer<'a>(
 }
 
 fn check_attributes(mesh: &TriMesh, attrs: &MeshAttributes, path: &str) -> Result<(), IoError> {
-    let bad = |message: String| IoError::BadAttribute {
+    let bad = |problem: AttributeProblem| IoError::BadAttribute {
         path: path.to_string(),
-        message,
+        problem,
     };
     for (name, vals) in &attrs.face_ints {
         if vals.len() != mesh.n_faces() {
-            return Err(bad(format!(
-                "face property `{name}` has {} values for {} faces",
-                vals.len(),
-                mesh.n_faces()
-            )));
+            return Err(bad(AttributeProblem::FacePropertyLength {
+                name: name.clone(),
+                values: vals.len(),
+                faces: mesh.n_faces(),
+            }));
         }
         if name.is_empty() || name.contains(char::is_whitespace) {
-            return Err(bad(format!("face property name {name:?} is not one word")));
+            return Err(bad(AttributeProblem::FacePropertyName {
+                name: name.clone(),
+            }));
         }
     }
     if let Some(c) = &attrs.face_colors {
         if c.len() != mesh.n_faces() {
-            return Err(bad(format!(
-                "{} face colours for {} faces",
-                c.len(),
-                mesh.n_faces()
-            )));
+            return Err(bad(AttributeProblem::FaceColors {
+                colors: c.len(),
+                faces: mesh.n_faces(),
+            }));
         }
     }
     if let Some(uv) = &attrs.uv {
         if uv.len() != mesh.n_vertices() {
-            return Err(bad(format!(
-                "{} uv coordinates for {} vertices",
-                uv.len(),
-                mesh.n_vertices()
-            )));
+            return Err(bad(AttributeProblem::UvCount {
+                uvs: uv.len(),
+                vertices: mesh.n_vertices(),
+            }));
         }
-        if uv.iter().any(|q| !(q.x.is_finite() && q.y.is_finite())) {
-            return Err(bad("non-finite uv coordinate".into()));
+        if let Some(v) = uv
+            .iter()
+            .position(|q| !(q.x.is_finite() && q.y.is_finite()))
+        {
+            return Err(bad(AttributeProblem::NonFiniteUv {
+                vertex: crate::ids::VertexId(v as u32),
+            }));
         }
     }
     Ok(())
@@ -573,7 +580,10 @@ pub(crate) fn build_mesh(
                 path: path.to_string(),
                 format,
                 line,
-                message: format!("face {f} has {} vertices (at least 3 needed)", poly.len()),
+                defect: Syntax::FewVertices {
+                    face: f,
+                    vertices: poly.len(),
+                },
             });
         }
         for &i in poly {
@@ -660,9 +670,11 @@ pub(crate) fn check_claim(
         return Err(IoError::Truncated {
             path: path.to_string(),
             format,
-            message: format!(
-                "header claims {claimed} {what}, more than the file's {file_bytes} bytes can hold"
-            ),
+            missing: Truncation::Claim {
+                claimed,
+                what,
+                file_bytes,
+            },
         });
     }
     Ok(())

@@ -4,7 +4,7 @@
 //! comments may hold bytes that are not UTF-8.
 
 use super::text::{as_text_with_names, float, int, short};
-use super::{build_mesh, uv_per_vertex, IoError, LoadedMesh, MeshAttributes, RawFaces};
+use super::{build_mesh, uv_per_vertex, IoError, LoadedMesh, MeshAttributes, RawFaces, Syntax};
 use crate::mesh::TriMesh;
 use nalgebra::{Point2, Point3};
 use std::io::Write;
@@ -142,7 +142,10 @@ fn vertex_line(
             path: path.to_string(),
             format: F,
             line: l,
-            message: format!("vertex with {} coordinates, 3 needed", c.len()),
+            defect: Syntax::FewCoordinates {
+                vertex: n,
+                coordinates: c.len(),
+            },
         });
     }
     let p = Point3::new(
@@ -173,7 +176,7 @@ fn texture_line(
             path: path.to_string(),
             format: F,
             line: l,
-            message: "non-finite texture coordinate".into(),
+            defect: Syntax::NonFiniteTexture,
         });
     }
     Ok(Point2::new(u, v))
@@ -217,10 +220,11 @@ fn face_line(
                             path: path.to_string(),
                             format: F,
                             line: l,
-                            message: format!(
-                                "face {f}: texture index {wt} does not exist ({} defined)",
-                                vts.len()
-                            ),
+                            defect: Syntax::BadTextureIndex {
+                                face: f,
+                                index: wt,
+                                defined: vts.len(),
+                            },
                         })
                     }
                     _ => {}

@@ -3,7 +3,7 @@
 //! (each vertex and face is one line). Binary OFF and 4D/nD OFF are refused by name.
 
 use super::text::{as_text_with_names, count, float, int};
-use super::{build_mesh, check_claim, IoError, LoadedMesh, RawFaces};
+use super::{build_mesh, check_claim, IoError, LoadedMesh, RawFaces, Syntax, Truncation, Unread};
 use crate::mesh::TriMesh;
 use nalgebra::Point3;
 use std::io::Write;
@@ -72,7 +72,9 @@ fn counts<'a>(
         return Err(IoError::Unsupported {
             path: path.to_string(),
             format: F,
-            what: format!("`{magic}` (vertices not in 3D)"),
+            what: Unread::OffDimension {
+                magic: magic.to_string(),
+            },
         });
     }
     let mut rest: Vec<&str> = head.collect();
@@ -80,7 +82,7 @@ fn counts<'a>(
         return Err(IoError::Unsupported {
             path: path.to_string(),
             format: F,
-            what: "binary OFF".into(),
+            what: Unread::BinaryOff,
         });
     }
     let mut count_line = 1;
@@ -89,7 +91,7 @@ fn counts<'a>(
             return Err(IoError::Truncated {
                 path: path.to_string(),
                 format: F,
-                message: "no counts line after the header".into(),
+                missing: Truncation::NoCounts,
             });
         };
         count_line = l;
@@ -100,7 +102,7 @@ fn counts<'a>(
             path: path.to_string(),
             format: F,
             line: count_line,
-            message: "expected the counts `V F E`".into(),
+            defect: Syntax::NoCounts,
         });
     }
     let nv = count(rest[0], count_line, path, F)?;
@@ -120,7 +122,11 @@ fn read_vertices<'a>(
             return Err(IoError::Truncated {
                 path: path.to_string(),
                 format: F,
-                message: format!("header claims {nv} vertices, file ends after {i}"),
+                missing: Truncation::Elements {
+                    claimed: nv,
+                    what: "vertices",
+                    found: i,
+                },
             });
         };
         let t: Vec<&str> = s.split_ascii_whitespace().take(3).collect();
@@ -129,7 +135,10 @@ fn read_vertices<'a>(
                 path: path.to_string(),
                 format: F,
                 line: l,
-                message: format!("vertex {i} has {} coordinates, 3 needed", t.len()),
+                defect: Syntax::FewCoordinates {
+                    vertex: i,
+                    coordinates: t.len(),
+                },
             });
         }
         let p = Point3::new(
@@ -161,7 +170,11 @@ fn read_face<'a>(
         return Err(IoError::Truncated {
             path: path.to_string(),
             format: F,
-            message: format!("header claims {nf} faces, file ends after {f}"),
+            missing: Truncation::Elements {
+                claimed: nf,
+                what: "faces",
+                found: f,
+            },
         });
     };
     let mut t = s.split_ascii_whitespace();
@@ -186,10 +199,11 @@ fn read_face<'a>(
                 path: path.to_string(),
                 format: F,
                 line: l2,
-                message: format!(
-                    "face {f} announces {k} vertices; it continues from line {l} on this \
-                     line, which holds more than the rest of its indices"
-                ),
+                defect: Syntax::FaceOverflow {
+                    face: f,
+                    announced: k,
+                    from_line: l,
+                },
             });
         }
         for tok in toks {
@@ -204,7 +218,11 @@ fn read_face<'a>(
             path: path.to_string(),
             format: F,
             line: l,
-            message: format!("face {f} announces {k} vertices but lists {got}"),
+            defect: Syntax::FaceShort {
+                face: f,
+                announced: k,
+                listed: got,
+            },
         });
     }
     Ok(())

@@ -3,7 +3,7 @@
 //! the face (Algorithm 1's order of creation) or `-` for a face that no patch made (an input
 //! face kept as it was). Lines starting with `#` are comments.
 
-use super::IoError;
+use super::{IoError, Syntax};
 use crate::ids::PatchId;
 use std::path::Path;
 
@@ -42,7 +42,7 @@ pub fn read_face_patches_bytes(bytes: &[u8], path: &str) -> Result<Vec<Option<Pa
             .iter()
             .filter(|&&b| b == b'\n')
             .count(),
-        message: "not UTF-8 text".into(),
+        defect: Syntax::NotUtf8,
     })?;
     let mut out = Vec::new();
     for (i, line) in text.lines().enumerate() {
@@ -56,11 +56,9 @@ pub fn read_face_patches_bytes(bytes: &[u8], path: &str) -> Result<Vec<Option<Pa
                 path: path.to_string(),
                 format: F,
                 line: i + 1,
-                message: format!(
-                    "expected a patch id (0 to {}) or -, got {:?}",
-                    u32::MAX,
-                    super::printable(t.as_bytes())
-                ),
+                defect: Syntax::NotAPatchId {
+                    found: super::printable(t.as_bytes()),
+                },
             })?)),
         });
     }

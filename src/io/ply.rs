@@ -10,7 +10,8 @@
 
 use super::text::{as_text, short, Tokens};
 use super::{
-    build_mesh, capped, check_claim, IoError, LoadedMesh, MeshAttributes, RawFaces, WriteOptions,
+    build_mesh, capped, check_claim, IoError, LoadedMesh, MeshAttributes, RawFaces, Syntax,
+    Truncation, Unread, Want, WriteOptions,
 };
 use crate::mesh::TriMesh;
 use nalgebra::{Point2, Point3};
@@ -140,10 +141,11 @@ impl Reader<'_, '_> {
         IoError::Truncated {
             path: self.path.to_string(),
             format: F,
-            message: format!(
-                "file ends inside element `{}` {i} of {} (header claims {})",
-                el.name, el.count, el.count
-            ),
+            missing: Truncation::InsideElement {
+                element: el.name.clone(),
+                index: i,
+                claimed: el.count,
+            },
         }
     }
 
@@ -153,22 +155,25 @@ impl Reader<'_, '_> {
                 let Some((line, tok)) = t.next() else {
                     return Err(self.truncated(el, i));
                 };
-                let bad = |what: &str| IoError::Parse {
+                let bad = |expected: Want| IoError::Parse {
                     path: self.path.to_string(),
                     format: F,
                     line,
-                    message: format!(
-                        "element `{}` {i}: expected {what}, found `{}`",
-                        el.name,
-                        short(tok)
-                    ),
+                    defect: Syntax::ElementValue {
+                        element: el.name.clone(),
+                        index: i,
+                        expected,
+                        found: short(tok),
+                    },
                 };
                 if ty.is_int() {
                     tok.parse::<i64>()
                         .map(Num::I)
-                        .map_err(|_| bad("an integer"))
+                        .map_err(|_| bad(Want::Integer))
                 } else {
-                    tok.parse::<f64>().map(Num::F).map_err(|_| bad("a number"))
+                    tok.parse::<f64>()
+                        .map(Num::F)
+                        .map_err(|_| bad(Want::Number))
                 }
             }
             Body::Binary {
@@ -213,10 +218,12 @@ impl Reader<'_, '_> {
                 path: self.path.to_string(),
                 format: F,
                 line,
-                message: format!(
-                    "element `{}` {i}: list `{}` has length {n}",
-                    el.name, p.name
-                ),
+                defect: Syntax::NegativeListLength {
+                    element: el.name.clone(),
+                    index: i,
+                    list: p.name.clone(),
+                    length: n,
+                },
             });
         }
         let n = n as u64;
@@ -237,11 +244,11 @@ struct Header {
 }
 
 fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
-    let err = |line: usize, message: String| IoError::Parse {
+    let err = |line: usize, defect: Syntax| IoError::Parse {
         path: path.to_string(),
         format: F,
         line,
-        message,
+        defect,
     };
     let (lines, body_start, end_line) = header_lines(bytes, path)?;
     let mut h = Header {
@@ -263,18 +270,25 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
                     other => {
                         return Err(err(
                             l,
-                            format!("unknown format `{}`", short(other.unwrap_or(""))),
+                            Syntax::PlyFormat {
+                                found: short(other.unwrap_or("")),
+                            },
                         ))
                     }
                 });
             }
             Some("element") => {
                 if t.len() != 3 {
-                    return Err(err(l, "expected `element NAME COUNT`".into()));
+                    return Err(err(
+                        l,
+                        Syntax::HeaderLine {
+                            expected: "element NAME COUNT",
+                        },
+                    ));
                 }
                 let count = t[2]
                     .parse::<u64>()
-                    .map_err(|_| err(l, format!("bad element count `{}`", short(t[2]))))?;
+                    .map_err(|_| err(l, Syntax::ElementCount { found: short(t[2]) }))?;
                 h.elements.push(Element {
                     name: t[1].to_string(),
                     count,
@@ -283,7 +297,7 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
             }
             Some("property") => {
                 let Some(el) = h.elements.last_mut() else {
-                    return Err(err(l, "property before any element".into()));
+                    return Err(err(l, Syntax::PropertyBeforeElement));
                 };
                 let prop = parse_property(&t, l, el, path)?;
                 el.props.push(prop);
@@ -298,7 +312,7 @@ fn parse_header(bytes: &[u8], path: &str) -> Result<Header, IoError> {
         }
     }
     if h.format.is_none() {
-        return Err(err(2, "no `format` line".into()));
+        return Err(err(2, Syntax::NoFormatLine));
     }
     Ok(h)
 }
@@ -339,7 +353,7 @@ fn header_lines<'b>(
             return Err(IoError::Truncated {
                 path: path.to_string(),
                 format: F,
-                message: "header has no `end_header` line".into(),
+                missing: Truncation::NoEndHeader,
             });
         }
         // A header line ends with LF, CRLF or a lone CR.
@@ -363,7 +377,7 @@ fn header_lines<'b>(
                 path: path.to_string(),
                 format: F,
                 line: line_no,
-                message: "header line is not text".into(),
+                defect: Syntax::HeaderNotText,
             });
         };
         if text.trim() == "end_header" {
@@ -376,11 +390,11 @@ fn header_lines<'b>(
 
 /// One `property` line (`t`, split at whitespace; line `l`) of element `el`.
 fn parse_property(t: &[&str], l: usize, el: &Element, path: &str) -> Result<Prop, IoError> {
-    let err = |message: String| IoError::Parse {
+    let err = |defect: Syntax| IoError::Parse {
         path: path.to_string(),
         format: F,
         line: l,
-        message,
+        defect,
     };
     let unknown = |ty: &str, name: &str| IoError::UnknownProperty {
         path: path.to_string(),
@@ -391,15 +405,17 @@ fn parse_property(t: &[&str], l: usize, el: &Element, path: &str) -> Result<Prop
     };
     if t.get(1) == Some(&"list") {
         if t.len() != 5 {
-            return Err(err("expected `property list COUNT_TYPE TYPE NAME`".into()));
+            return Err(err(Syntax::HeaderLine {
+                expected: "property list COUNT_TYPE TYPE NAME",
+            }));
         }
         let ct = Ty::parse(t[2]).ok_or_else(|| unknown(t[2], t[4]))?;
         let ty = Ty::parse(t[3]).ok_or_else(|| unknown(t[3], t[4]))?;
         if !ct.is_int() {
-            return Err(err(format!(
-                "list `{}` has non-integer count type `{}`",
-                t[4], t[2]
-            )));
+            return Err(err(Syntax::ListCountType {
+                list: short(t[4]),
+                ty: short(t[2]),
+            }));
         }
         Ok(Prop {
             name: t[4].to_string(),
@@ -408,7 +424,9 @@ fn parse_property(t: &[&str], l: usize, el: &Element, path: &str) -> Result<Prop
         })
     } else {
         if t.len() != 3 {
-            return Err(err("expected `property TYPE NAME`".into()));
+            return Err(err(Syntax::HeaderLine {
+                expected: "property TYPE NAME",
+            }));
         }
         Ok(Prop {
             name: t[2].to_string(),
@@ -517,12 +535,12 @@ fn body<'a>(
                 path,
                 format,
                 line,
-                message,
+                defect,
             } => IoError::Parse {
                 path,
                 format,
                 line: line + body_first_line - 1,
-                message,
+                defect,
             },
             e => e,
         })?,
@@ -530,12 +548,12 @@ fn body<'a>(
     )))
 }
 
-fn parse_err(path: &str, message: String) -> IoError {
+fn parse_err(path: &str, defect: Syntax) -> IoError {
     IoError::Parse {
         path: path.to_string(),
         format: F,
         line: 0,
-        message,
+        defect,
     }
 }
 
@@ -551,10 +569,7 @@ fn read_vertices(
     c.saw_vertex = true;
     let xyz = [el.find(&["x"]), el.find(&["y"]), el.find(&["z"])];
     let [Some(x), Some(y), Some(z)] = xyz else {
-        return Err(parse_err(
-            path,
-            "element `vertex` lacks scalar x, y or z".into(),
-        ));
+        return Err(parse_err(path, Syntax::NoPosition));
     };
     let uvp = el
         .find(&["u", "s", "texture_u"])
@@ -606,16 +621,15 @@ fn read_faces(
         return Err(IoError::Unsupported {
             path: path.to_string(),
             format: F,
-            what: "element `face` without a `vertex_indices` list".into(),
+            what: Unread::NoVertexIndices { element: "face" },
         });
     };
     if !el.props[li].ty.is_int() {
         return Err(parse_err(
             path,
-            format!(
-                "face list `{}` has non-integer index type",
-                el.props[li].name
-            ),
+            Syntax::ListIndexType {
+                list: el.props[li].name.clone(),
+            },
         ));
     }
     let int_scalar = |name: &str| {
@@ -686,7 +700,9 @@ fn read_tristrips(
         return Err(IoError::Unsupported {
             path: rd.path.to_string(),
             format: F,
-            what: "element `tristrips` without a `vertex_indices` list".into(),
+            what: Unread::NoVertexIndices {
+                element: "tristrips",
+            },
         });
     };
     let roles = FaceRoles {
@@ -704,7 +720,7 @@ fn read_tristrips(
 /// The mesh from the elements read, with the face attributes spread over the triangles.
 fn loaded_mesh(c: Contents, mut warnings: Vec<String>, path: &str) -> Result<LoadedMesh, IoError> {
     if !c.saw_vertex {
-        return Err(parse_err(path, "no `vertex` element".into()));
+        return Err(parse_err(path, Syntax::NoVertexElement));
     }
     if !c.saw_faces {
         return Err(IoError::NoFaces {

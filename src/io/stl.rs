@@ -5,7 +5,7 @@
 //! with `solid`. Binary STL holds `f32`: writing rounds each coordinate to the nearest `f32`.
 
 use super::text::{as_text, float, short, Tokens};
-use super::{build_mesh, IoError, LoadedMesh, RawFaces, WriteOptions};
+use super::{build_mesh, IoError, LoadedMesh, RawFaces, Syntax, Truncation, WriteOptions};
 use crate::mesh::TriMesh;
 use nalgebra::Point3;
 use std::collections::HashMap;
@@ -95,10 +95,9 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     Err(IoError::Truncated {
         path: path.to_string(),
         format: F,
-        message: format!(
-            "{} bytes: not ASCII (no `solid`) and shorter than the 84-byte binary header",
-            bytes.len()
-        ),
+        missing: Truncation::ShortStl {
+            file_bytes: bytes.len(),
+        },
     })
 }
 
@@ -108,10 +107,11 @@ fn read_binary(bytes: &[u8], count: u64, path: &str) -> Result<LoadedMesh, IoErr
         return Err(IoError::Truncated {
             path: path.to_string(),
             format: F,
-            message: format!(
-                "header claims {count} facets ({need} bytes), file has {} bytes",
-                bytes.len()
-            ),
+            missing: Truncation::Facets {
+                claimed: count,
+                need,
+                file_bytes: bytes.len(),
+            },
         });
     }
     let mut warnings = Vec::new();
@@ -169,16 +169,20 @@ fn read_ascii(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
             w.facet(c, vl, path)?;
             next = t.next();
         } else {
-            let want = if in_solid {
-                "`facet` or `endsolid`"
+            let found = short(tok);
+            let defect = if in_solid {
+                Syntax::NotAFacet { found }
             } else {
-                "`solid`"
+                Syntax::ExpectedKeyword {
+                    keyword: "solid",
+                    found,
+                }
             };
             return Err(IoError::Parse {
                 path: path.to_string(),
                 format: F,
                 line: l,
-                message: format!("expected {want}, found `{}`", short(tok)),
+                defect,
             });
         }
     }
@@ -186,7 +190,7 @@ fn read_ascii(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         return Err(IoError::Truncated {
             path: path.to_string(),
             format: F,
-            message: format!("file ends before `endsolid` (line {})", t.last_line),
+            missing: Truncation::NoEndsolid { line: t.last_line },
         });
     }
     if w.corners == 0 {
@@ -199,22 +203,25 @@ fn read_ascii(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
 }
 
 /// The next token must be `word`; returns its line.
-fn expect(t: &mut Tokens, word: &str, path: &str) -> Result<usize, IoError> {
+fn expect(t: &mut Tokens, word: &'static str, path: &str) -> Result<usize, IoError> {
     match t.next() {
         Some((l, tok)) if tok.eq_ignore_ascii_case(word) => Ok(l),
         Some((l, tok)) => Err(IoError::Parse {
             path: path.to_string(),
             format: F,
             line: l,
-            message: format!("expected `{word}`, found `{}`", short(tok)),
+            defect: Syntax::ExpectedKeyword {
+                keyword: word,
+                found: short(tok),
+            },
         }),
         None => Err(IoError::Truncated {
             path: path.to_string(),
             format: F,
-            message: format!(
-                "file ends where `{word}` was expected (line {})",
-                t.last_line
-            ),
+            missing: Truncation::Keyword {
+                keyword: word,
+                line: t.last_line,
+            },
         }),
     }
 }
@@ -225,7 +232,7 @@ fn num(t: &mut Tokens, path: &str) -> Result<f64, IoError> {
         None => Err(IoError::Truncated {
             path: path.to_string(),
             format: F,
-            message: format!("file ends inside a facet (line {})", t.last_line),
+            missing: Truncation::InsideFacet { line: t.last_line },
         }),
     }
 }

@@ -1,6 +1,6 @@
 //! Shared helpers of the text formats: UTF-8 check, tokens with line numbers, numbers.
 
-use super::IoError;
+use super::{IoError, Syntax, Want};
 
 /// The file as text, or a parse error naming the line of the first byte that is not text
 /// (binary garbage with a text extension).
@@ -22,7 +22,7 @@ pub(crate) fn as_text<'a>(
         path: path.to_string(),
         format,
         line,
-        message: format!("binary data (byte {bad_at} is not text)"),
+        defect: Syntax::Binary { byte: bad_at },
     })
 }
 
@@ -62,11 +62,7 @@ pub(crate) fn as_text_with_names<'a>(
                         path: path.to_string(),
                         format,
                         line: line_index + 1,
-                        message: format!(
-                            "binary data (byte {} is not text; only names and comments may \
-                             hold bytes that are not UTF-8)",
-                            start + bad
-                        ),
+                        defect: Syntax::BinaryOutsideNames { byte: start + bad },
                     });
                 }
                 text.push_str(&String::from_utf8_lossy(line));
@@ -161,7 +157,10 @@ pub(crate) fn float(
         path: path.to_string(),
         format,
         line,
-        message: format!("expected a number, found `{}`", short(tok)),
+        defect: Syntax::Expected {
+            expected: Want::Number,
+            found: short(tok),
+        },
     })
 }
 
@@ -176,7 +175,10 @@ pub(crate) fn int(
         path: path.to_string(),
         format,
         line,
-        message: format!("expected an integer, found `{}`", short(tok)),
+        defect: Syntax::Expected {
+            expected: Want::Integer,
+            found: short(tok),
+        },
     })
 }
 
@@ -191,7 +193,10 @@ pub(crate) fn count(
         path: path.to_string(),
         format,
         line,
-        message: format!("expected a count, found `{}`", short(tok)),
+        defect: Syntax::Expected {
+            expected: Want::Count,
+            found: short(tok),
+        },
     })
 }
 

@@ -113,14 +113,14 @@ pub(super) enum ToolError {
         source: ChildError,
     },
     /// The child exited with a failure.
-    #[error("{step} failed ({status}): {message}")]
+    #[error("{step} failed ({status}): {stderr_line}")]
     Failed {
         /// the child: the tool, `remesh`, `eval`, `convert`
         step: &'static str,
         /// its exit status
         status: ExitStatus,
-        /// the line of its stderr that names the error
-        message: String,
+        /// the line of its stderr that names the error (the child's text, as it wrote it)
+        stderr_line: String,
     },
     /// The tool succeeded without writing its output.
     #[error("{tool} exited without writing {}", output.display())]
@@ -166,7 +166,7 @@ impl ToolError {
         ToolError::Failed {
             step,
             status: f.status,
-            message: error_line(&String::from_utf8_lossy(&f.stderr)).to_string(),
+            stderr_line: error_line(&String::from_utf8_lossy(&f.stderr)).to_string(),
         }
     }
 }
