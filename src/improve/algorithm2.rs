@@ -195,8 +195,9 @@ impl Progress {
         }
     }
 
-    /// Fewer faces to improve, or a larger smallest angle (a pass whose splits cut a cap into
-    /// faces still under the angle threshold has more of them, and better).
+    /// Fewer faces to improve, or a larger smallest angle: a pass that opens the worst face
+    /// may leave as many faces under the thresholds (it trades one for another elsewhere in
+    /// the patch), and the next pass, one ring wider, still has work.
     fn beats(&self, before: &Progress) -> bool {
         self.bad < before.bad || self.theta_min > before.theta_min
     }

@@ -63,14 +63,6 @@ pub struct Eq5Options {
     /// edge makes a small angle that neither flips nor moves can open: the vertices around it
     /// are too many for the space.
     pub collapse_below_deg: f64,
-    /// Edge splits after each connectivity update: a triangle whose smallest metric angle is
-    /// below this (degrees) and whose largest is at least [`SPLIT_OBTUSE_DEG`] has its longest
-    /// edge split at its midpoint when the edge is inside the patch and, once the new vertex
-    /// has moved, the smallest angle around it beats the two triangles' before (default 0:
-    /// none). A cap whose three corners are held (kept corners, a feature line, the patch
-    /// boundary) has no vertex to move and no flip to take; a new vertex opposite its obtuse
-    /// corner cuts it in two.
-    pub split_below_deg: f64,
 }
 
 impl Default for Eq5Options {
@@ -83,7 +75,6 @@ impl Default for Eq5Options {
             flip_rule: FlipRule::Energy,
             target: Target::OwnArea,
             collapse_below_deg: 0.0,
-            split_below_deg: 0.0,
         }
     }
 }
@@ -123,8 +114,6 @@ pub struct Eq5Counts {
     pub flips: usize,
     /// Edges collapsed.
     pub collapses: usize,
-    /// Edges split.
-    pub splits: usize,
     /// Rounds run (a round that changes nothing ends the updates).
     pub rounds: usize,
 }
@@ -568,114 +557,6 @@ impl State<'_> {
         collapses
     }
 
-    /// One sweep of edge splits: each triangle (in id order) whose smallest metric angle is
-    /// below `below_deg` and whose largest is at least [`SPLIT_OBTUSE_DEG`] has its longest
-    /// edge `ab` split at the midpoint `m` when `ab` is not locked and has a triangle `bad` on
-    /// its other side: `abc`, `bad` become `amc`, `mbc`, `bmd`, `mad` (positive: `m` lies on
-    /// `ab` strictly between its ends), `m` takes `steps` position updates, and the split stays
-    /// when the smallest angle around `m` is larger than that of `abc` and `bad` before;
-    /// otherwise it is undone. The triangles touched wait for the next sweep.
-    fn split_pass(&mut self, below_deg: f64, steps: usize, halvings: usize) -> usize {
-        let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
-        for (i, t) in self.tris.iter().enumerate() {
-            for k in 0..3 {
-                edges.insert((t[k], t[(k + 1) % 3]), i as u32);
-            }
-        }
-        let n_tris = self.tris.len();
-        let mut touched = vec![false; n_tris];
-        let mut splits = 0;
-        for t in 0..n_tris {
-            let tri = self.tris[t];
-            if touched[t] {
-                continue;
-            }
-            let l = self.sides(tri);
-            if smallest_angle_deg(l) >= below_deg || largest_angle_deg(l) < SPLIT_OBTUSE_DEG {
-                continue;
-            }
-            // Side k joins corners k+1 and k+2 and is opposite corner k.
-            let k = (0..3).max_by(|&i, &j| l[i].total_cmp(&l[j])).unwrap_or(0);
-            let (a, b, c) = (tri[(k + 1) % 3], tri[(k + 2) % 3], tri[k]);
-            if self.locked.contains(&(a.min(b), a.max(b))) {
-                continue;
-            }
-            let Some(&t2) = edges.get(&(b, a)) else {
-                continue;
-            };
-            let t2 = t2 as usize;
-            // A triangle this sweep made (index past `touched`) waits too.
-            if touched.get(t2).copied().unwrap_or(true) {
-                continue;
-            }
-            let other = self.tris[t2];
-            let Some(d) = other.iter().copied().find(|&v| v != a && v != b) else {
-                continue;
-            };
-            let p = Point2::from((self.pts[a as usize].coords + self.pts[b as usize].coords) / 2.0);
-            let Some(tensor) = clamp_spd(&self.metric.metric(&p)) else {
-                continue;
-            };
-            let before = self.min_angle(tri).min(self.min_angle(other));
-            let m = self.pts.len() as u32;
-            self.pts.push(p);
-            self.tensors.push(tensor);
-            self.fixed.push(false);
-            self.moved.push(true);
-            let new = [[a, m, c], [b, m, d], [m, b, c], [m, a, d]];
-            self.tris[t] = new[0];
-            self.tris[t2] = new[1];
-            self.tris.extend_from_slice(&new[2..]);
-            self.rebuild_stars();
-            let positive = new.iter().all(|&n| self.positive(n, None));
-            for _ in 0..steps {
-                if !positive || !self.move_vertex(m, halvings) {
-                    break;
-                }
-            }
-            let after = self.star[m as usize]
-                .iter()
-                .map(|&s| self.min_angle(self.tris[s as usize]))
-                .fold(f64::INFINITY, f64::min);
-            if positive && after > before {
-                for (i, n) in [t, t2, n_tris + 2 * splits, n_tris + 2 * splits + 1]
-                    .into_iter()
-                    .zip(new)
-                {
-                    if let Some(f) = touched.get_mut(i) {
-                        *f = true;
-                    }
-                    for k in 0..3 {
-                        edges.insert((n[k], n[(k + 1) % 3]), i as u32);
-                    }
-                }
-                edges.remove(&(a, b));
-                edges.remove(&(b, a));
-                splits += 1;
-            } else {
-                self.tris[t] = tri;
-                self.tris[t2] = other;
-                self.tris.truncate(self.tris.len() - 2);
-                self.pts.pop();
-                self.tensors.pop();
-                self.fixed.pop();
-                self.moved.pop();
-                self.rebuild_stars();
-            }
-        }
-        splits
-    }
-
-    /// The metric side lengths of a triangle in its mean vertex tensor (side k opposite
-    /// corner k).
-    fn sides(&self, t: [u32; 3]) -> [f64; 3] {
-        let m = (self.tensors[t[0] as usize]
-            + self.tensors[t[1] as usize]
-            + self.tensors[t[2] as usize])
-            / 3.0;
-        crate::remesh2d::stats::sides_and_quality(&t.map(|v| self.pts[v as usize]), &m).0
-    }
-
     fn rebuild_stars(&mut self) {
         self.star = vec![Vec::new(); self.pts.len()];
         for (i, t) in self.tris.iter().enumerate() {
@@ -690,27 +571,15 @@ impl State<'_> {
 /// lengths Algorithm 1 aims at (paper-notes.md Sec. 3.4).
 const MAX_COLLAPSED_EDGE: f64 = 1.4;
 
-/// The smallest angle of a triangle that [`Eq5Options::split_below_deg`] splits its longest
-/// edge of: a cap. A needle (two long sides, one short) would give two needles.
-pub const SPLIT_OBTUSE_DEG: f64 = 100.0;
-
-/// The angles (degrees) of a triangle with sides `l`, by the law of cosines.
-fn angles_deg(l: [f64; 3]) -> impl Iterator<Item = f64> {
-    (0..3).map(move |i| {
-        let (a, b, c) = (l[i], l[(i + 1) % 3], l[(i + 2) % 3]);
-        let cs = ((b * b + c * c - a * a) / (2.0 * b * c)).clamp(-1.0, 1.0);
-        cs.acos().to_degrees()
-    })
-}
-
-/// The smallest angle (degrees) of a triangle with sides `l`.
+/// The smallest angle (degrees) of a triangle with sides `l`, by the law of cosines.
 fn smallest_angle_deg(l: [f64; 3]) -> f64 {
-    angles_deg(l).fold(f64::INFINITY, f64::min)
-}
-
-/// The largest angle (degrees) of a triangle with sides `l`.
-fn largest_angle_deg(l: [f64; 3]) -> f64 {
-    angles_deg(l).fold(f64::NEG_INFINITY, f64::max)
+    (0..3)
+        .map(|i| {
+            let (a, b, c) = (l[i], l[(i + 1) % 3], l[(i + 2) % 3]);
+            let cs = ((b * b + c * c - a * a) / (2.0 * b * c)).clamp(-1.0, 1.0);
+            cs.acos().to_degrees()
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// `t` is the triangle `(a, b, c)`, in some rotation.
@@ -766,7 +635,7 @@ pub fn improve_planar(
     for _ in 0..options.rounds {
         counts.rounds += 1;
         // Worst ring first; ties by id, so the order is deterministic.
-        let mut order: Vec<(f64, u32)> = (0..s.pts.len() as u32)
+        let mut order: Vec<(f64, u32)> = (0..n as u32)
             .filter(|&v| !s.fixed[v as usize] && !s.star[v as usize].is_empty())
             .map(|v| (s.ring_energy(v, None), v))
             .collect();
@@ -789,18 +658,12 @@ pub fn improve_planar(
             counts.collapses += collapses;
             changed += collapses;
         }
-        if options.split_below_deg > 0.0 {
-            let splits = s.split_pass(options.split_below_deg, options.steps, options.line_search);
-            counts.splits += splits;
-            changed += splits;
-        }
         if changed == 0 {
             break;
         }
     }
     // Collapsed vertices have no triangles left; only free vertices collapse, so every
     // boundary and constrained vertex stays.
-    let n = s.pts.len();
     let mut new_id = vec![u32::MAX; n];
     let (mut points, mut origin) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for (v, id) in new_id.iter_mut().enumerate() {

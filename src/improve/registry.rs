@@ -105,11 +105,6 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
                 doc: "what a patch must not lower: q-angles (q_min and θ_min) or angles (θ_min only)",
                 default: |_| bottom_name(ImproveOptions::default().bottom).to_string(),
             },
-            OptionDoc {
-                name: "split",
-                doc: "split the longest edge of an obtuse triangle whose smallest angle is below this (degrees, [0, 60); 0: none) when that raises the smallest angle around it",
-                default: |_| ImproveOptions::default().planar.split_below_deg.to_string(),
-            },
         ],
         build: eq5,
     },
@@ -209,11 +204,6 @@ fn eq5(p: &mut Params, _: MetricSizes) -> Result<Box<dyn Improver>, BadValue> {
         (0.0..60.0).contains(&a)
     })? {
         o.planar.collapse_below_deg = a;
-    }
-    if let Some(a) = p.take_checked("split", "an angle in [0, 60) degrees", |a: f64| {
-        (0.0..60.0).contains(&a)
-    })? {
-        o.planar.split_below_deg = a;
     }
     Ok(Box::new(Algorithm2 { options: o }))
 }

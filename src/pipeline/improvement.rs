@@ -114,14 +114,6 @@ fn patch_pass(
         let patch = super::next_patch(&ictx, state, rng)?;
         let pid = crate::ids::PatchId::new(state.patches);
         let (outcome, log) = step::patch_step(&ictx, state, pid, &patch, rng)?;
-        if std::env::var("CM_DBG").is_ok() {
-            if let PatchOutcome::Remeshed { faces, refined, .. } = &outcome {
-                let o = qualities_of_faces(ctx, state, faces);
-                let n = qualities_of_candidate(ctx, state, &refined.replacement);
-                let mn = |v: &[TriangleQuality]| v.iter().map(|t| t.min_angle()).fold(f64::INFINITY, f64::min);
-                eprintln!("DBG patch {} faces {}->{} min {:.2}->{:.2} acc {} surf {}", pid, o.len(), n.len(), mn(&o), mn(&n), accept(&o, &n), keeps_the_surface(ctx, state, faces, &refined.replacement));
-            } else { eprintln!("DBG patch {} not remeshed", pid); }
-        }
         let outcome = match outcome {
             PatchOutcome::Remeshed {
                 faces,
