@@ -218,9 +218,23 @@ impl<I, T> IdMap<I, T> {
         &mut self.values
     }
 
+    /// No element (the memory is kept for the next values).
+    pub fn clear(&mut self) {
+        self.values.clear();
+    }
+
     /// A new element's value (its id is the old length).
     pub fn push(&mut self, value: T) {
         self.values.push(value);
+    }
+
+    /// `n` elements: a map behind its mesh catches up with `value` for the missing
+    /// elements' values; one ahead drops its last values.
+    pub fn resize(&mut self, n: usize, value: T)
+    where
+        T: Clone,
+    {
+        self.values.resize(n, value);
     }
 
     /// Drop the elements marked in `gone` (`gone[i]`: element `i` is removed), keeping the
@@ -241,6 +255,12 @@ impl<I: ElementId, T> IdMap<I, T> {
     #[inline]
     pub fn get(&self, id: I) -> Option<&T> {
         self.values.get(id.index())
+    }
+
+    /// The value of element `id` to change, `None` past the end.
+    #[inline]
+    pub fn get_mut(&mut self, id: I) -> Option<&mut T> {
+        self.values.get_mut(id.index())
     }
 
     /// Follow an old → new id map that keeps the order (`map[old]`: the element's new id,

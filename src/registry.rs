@@ -20,6 +20,20 @@ use std::collections::BTreeMap;
 use std::str::FromStr;
 use thiserror::Error;
 
+/// The names a lookup could have matched, as data; printed comma-separated ("none" when
+/// there are none).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Names(pub Vec<&'static str>);
+
+impl std::fmt::Display for Names {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0.as_slice() {
+            [] => f.write_str("none"),
+            names => f.write_str(&names.join(", ")),
+        }
+    }
+}
+
 /// Errors of building a registered implementation.
 #[derive(Debug, Error, Clone, PartialEq, Eq)]
 pub enum RegistryError {
@@ -31,7 +45,7 @@ pub enum RegistryError {
         /// the name asked for
         name: String,
         /// the names in the table
-        known: String,
+        known: Names,
     },
     /// An option the row does not have.
     #[error("{kind} `{name}` has no option `{option}` (its options: {known})")]
@@ -43,7 +57,7 @@ pub enum RegistryError {
         /// the option asked for
         option: String,
         /// the row's options
-        known: String,
+        known: Names,
     },
     /// An option value that does not parse or is out of range.
     #[error("{kind} `{name}`, option `{option}`: `{value}` is not {expected}")]
@@ -302,7 +316,7 @@ pub fn build<T: ?Sized + Stage>(
             .ok_or_else(|| RegistryError::UnknownName {
                 kind,
                 name: name.to_string(),
-                known: names(table).join(", "),
+                known: Names(names(table)),
             })?;
     let built = (entry.build)(&mut params, sizes).map_err(|b| RegistryError::BadValue {
         kind,
@@ -316,10 +330,7 @@ pub fn build<T: ?Sized + Stage>(
             kind,
             name: entry.name,
             option: option.clone(),
-            known: match entry.options {
-                [] => "none".to_string(),
-                o => o.iter().map(|o| o.name).collect::<Vec<_>>().join(", "),
-            },
+            known: Names(entry.options.iter().map(|o| o.name).collect()),
         });
     }
     if built.stage_name() != entry.name {
@@ -446,12 +457,12 @@ mod tests {
         assert_eq!(b.word(), "hellohello");
         assert!(matches!(
             build(TABLE, "crow", p(&[]), MetricSizes::Relative),
-            Err(RegistryError::UnknownName { known, .. }) if known == "parrot"
+            Err(RegistryError::UnknownName { known, .. }) if known.0 == ["parrot"]
         ));
         assert!(matches!(
             build(TABLE, "parrot", p(&["volume=3"]), MetricSizes::Relative),
             Err(RegistryError::UnknownOption { option, known, .. })
-                if option == "volume" && known == "times"
+                if option == "volume" && known.0 == ["times"]
         ));
         for bad in ["times=0", "times=x", "times=-1"] {
             assert!(

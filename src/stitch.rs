@@ -8,7 +8,7 @@
 //! elements are stable while the loop runs.
 
 use crate::boundary::CurvePoint;
-use crate::ids::{FaceId, FaceMap, VertexId};
+use crate::ids::{FaceId, FaceMap, VertexId, VertexMap};
 use crate::mesh::{SurfaceLocation, TriMesh};
 use nalgebra::Point3;
 use thiserror::Error;
@@ -36,12 +36,12 @@ pub struct WorkingMesh {
     /// The current mesh (unit-diagonal space).
     pub mesh: TriMesh,
     /// `locations[v]`: where vertex `v` lies on the reference mesh.
-    pub locations: Vec<SurfaceLocation>,
+    pub locations: VertexMap<SurfaceLocation>,
     /// `processed[f]`: face `f` was produced by (or lies inside) an already remeshed patch.
     pub processed: FaceMap<bool>,
     /// `curve[v]`: where vertex `v` lies on the input's boundary curves, for boundary
     /// vertices ([`crate::boundary`]); `None` inside.
-    pub curve: Vec<Option<CurvePoint>>,
+    pub curve: VertexMap<Option<CurvePoint>>,
 }
 
 /// A vertex of a replacement triangle: an existing working-mesh vertex (patch boundary) or
@@ -68,22 +68,22 @@ pub struct Replacement {
     pub triangles: Vec<[PatchVertex; 3]>,
 }
 
+/// The location a vertex has before one is known (a referenced vertex always has one).
+const UNLOCATED: SurfaceLocation = SurfaceLocation {
+    face: FaceId(0),
+    bary: [1.0, 0.0, 0.0],
+};
+
 impl WorkingMesh {
     /// Start Algorithm 1 on `reference`: every vertex located at itself, nothing processed.
     pub fn from_reference(reference: &TriMesh) -> WorkingMesh {
-        let mut locations = vec![
-            SurfaceLocation {
-                face: FaceId(0),
-                bary: [1.0, 0.0, 0.0]
-            };
-            reference.n_vertices()
-        ];
+        let mut locations = VertexMap::filled(reference.n_vertices(), UNLOCATED);
         // Each vertex is located as a corner of its last incident face.
         for (f, t) in reference.triangles.iter().enumerate() {
-            for (k, v) in t.iter().enumerate() {
+            for (k, &v) in t.iter().enumerate() {
                 let mut bary = [0.0; 3];
                 bary[k] = 1.0;
-                locations[v.idx()] = SurfaceLocation {
+                locations[v] = SurfaceLocation {
                     face: FaceId::new(f),
                     bary,
                 };
@@ -93,7 +93,7 @@ impl WorkingMesh {
             mesh: reference.clone(),
             locations,
             processed: FaceMap::filled(reference.n_faces(), false),
-            curve: vec![None; reference.n_vertices()],
+            curve: VertexMap::filled(reference.n_vertices(), None),
         }
     }
 
@@ -105,23 +105,9 @@ impl WorkingMesh {
     /// Drop vertices no face references; returns the old → new vertex map.
     pub fn compact(&mut self) -> Vec<Option<VertexId>> {
         let (mesh, map) = self.mesh.without_unreferenced_vertices();
-        let mut locations = vec![
-            SurfaceLocation {
-                face: FaceId(0),
-                bary: [1.0, 0.0, 0.0]
-            };
-            mesh.n_vertices()
-        ];
-        let mut curve = vec![None; mesh.n_vertices()];
-        for (old, new) in map.iter().enumerate() {
-            if let Some(n) = new {
-                locations[n.idx()] = self.locations[old];
-                curve[n.idx()] = self.curve.get(old).copied().flatten();
-            }
-        }
         self.mesh = mesh;
-        self.locations = locations;
-        self.curve = curve;
+        self.locations.compact(&map, UNLOCATED);
+        self.curve.compact(&map, None);
         map
     }
 }
@@ -204,7 +190,8 @@ pub fn stitch_all(
         work.mesh
             .positions
             .extend_from_slice(&replacement.new_positions);
-        work.locations.extend_from_slice(&replacement.new_locations);
+        work.locations
+            .extend(replacement.new_locations.iter().copied());
         let n = work.mesh.n_vertices();
         work.curve.resize(n - replacement.new_positions.len(), None);
         for i in 0..replacement.new_positions.len() {
@@ -230,7 +217,7 @@ mod tests {
         let ring: Vec<VertexId> = (1..=6).map(VertexId).collect();
         let repl = Replacement {
             new_positions: vec![Point3::new(0.01, 0.0, 0.0)],
-            new_locations: vec![w.locations[0]],
+            new_locations: vec![w.locations[VertexId(0)]],
             new_curve: Vec::new(),
             triangles: (0..6)
                 .map(|i| {

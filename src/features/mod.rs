@@ -718,7 +718,7 @@ mod tests {
             assert!(lines.is_pinned(v));
             let p = w.mesh.positions[v.idx()];
             assert_eq!(p.z, 0.0, "{v} off the equator plane");
-            assert_eq!(w.locations[v.idx()].position(&m), p);
+            assert_eq!(w.locations[v].position(&m), p);
             assert!(lines.edges.iter().filter(|e| e.0 == v || e.1 == v).count() == 2);
         }
         // Every pinned vertex is on the equator, every equator vertex is pinned.
@@ -809,7 +809,7 @@ mod tests {
                 );
             }
             for v in m.n_vertices()..w.mesh.n_vertices() {
-                let loc = w.locations[v];
+                let loc = w.locations[VertexId::new(v)];
                 assert_eq!(loc.position(&m), w.mesh.positions[v], "{name}");
                 let on: Vec<usize> = (0..3).filter(|&k| loc.bary[k] != 0.0).collect();
                 assert_eq!(on.len(), 2, "{name}: v{v} not on an edge of its face");

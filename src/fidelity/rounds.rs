@@ -5,7 +5,7 @@
 
 use super::measure::{deviations, patch_vertex_factors, scale_metric, LiftedPatch, ScaleLimits};
 use super::FidelityOptions;
-use crate::ids::VertexId;
+use crate::ids::{VertexId, VertexMap};
 use crate::mesh::{PlanarMesh, SurfaceLocation, TriMesh};
 use crate::metric::MetricField;
 use crate::remesh2d::PlanarMetricField;
@@ -103,7 +103,7 @@ pub fn patch_metrics(
     carried: &VertexFactors,
     patch: &TriMesh,
     to_global: &[VertexId],
-    locations: &[SurfaceLocation],
+    locations: &VertexMap<SurfaceLocation>,
 ) -> Vec<Matrix3<f64>> {
     let reference = field.reference();
     let boost = if fid_scale.is_empty() {
@@ -115,7 +115,7 @@ pub fn patch_metrics(
         .iter()
         .enumerate()
         .map(|(i, g)| {
-            let loc = &locations[g.idx()];
+            let loc = &locations[*g];
             let m = field.eval_at(loc) * carried.get(*g).max(1.0);
             match boost.get(i) {
                 Some(&b) if b > 1.0 => {

@@ -198,14 +198,13 @@ pub struct SurfaceContext<'a> {
     /// `scope[v]`: the passes may move vertex `v` and flip the edges between such vertices
     /// (past the end: a vertex made after the flags were set, in scope); `None`: every vertex.
     /// The bands around the regions' cuts ([`crate::pipeline::RemeshOptions::region_faces`]).
-    pub scope: Option<&'a [bool]>,
+    pub scope: Option<&'a crate::ids::VertexMap<bool>>,
 }
 
 impl SurfaceContext<'_> {
     /// The passes may change vertex `v` ([`SurfaceContext::scope`]).
     pub fn in_scope(&self, v: crate::ids::VertexId) -> bool {
-        self.scope
-            .is_none_or(|s| s.get(v.idx()).copied().unwrap_or(true))
+        self.scope.is_none_or(|s| s.get(v).copied().unwrap_or(true))
     }
 }
 

@@ -165,7 +165,7 @@ fn slide(
     let Some(curves) = ctx.curves else {
         return false;
     };
-    let point = |u: VertexId| work.curve.get(u.idx()).copied().flatten();
+    let point = |u: VertexId| work.curve.get(u).copied().flatten();
     let (Some(p), Some(pa), Some(pb)) = (point(v), point(prev), point(next)) else {
         return false;
     };
@@ -244,8 +244,8 @@ fn try_candidates(
     let nbrs = topo.vertex_neighbors(v);
     let before = fan_quality(&work.mesh, &state.metrics, fan);
     let old = work.mesh.positions[vi];
-    let old_loc = work.locations[vi];
-    let old_curve = work.curve.get(vi).copied().flatten();
+    let old_loc = work.locations[v];
+    let old_curve = work.curve.get(v).copied().flatten();
     let old_m = state.metrics[vi];
     let mut scored: Vec<(f64, Candidate)> = candidates
         .iter()
@@ -266,7 +266,7 @@ fn try_candidates(
     let reference = ctx.field.reference();
     let mut watch: Vec<Point3<f64>> = std::iter::once(v)
         .chain(nbrs.iter().copied())
-        .flat_map(|u| reference.face(work.locations[u.idx()].face))
+        .flat_map(|u| reference.face(work.locations[u].face))
         .map(|r| reference.positions[r.idx()])
         .collect();
     watch.push(old);
@@ -277,7 +277,7 @@ fn try_candidates(
         .collect();
     for (_, c) in scored {
         work.mesh.positions[vi] = c.position;
-        work.locations[vi] = c.location;
+        work.locations[v] = c.location;
         state.metrics[vi] = ctx.field.eval_at(&c.location);
         let tris: Vec<[Point3<f64>; 3]> = fan
             .iter()
@@ -302,14 +302,14 @@ fn try_candidates(
                 }
             }
             if c.curve.is_some() {
-                work.curve[vi] = c.curve;
+                work.curve[v] = c.curve;
             }
             return true;
         }
         work.mesh.positions[vi] = old;
-        work.locations[vi] = old_loc;
+        work.locations[v] = old_loc;
         state.metrics[vi] = old_m;
-        if let Some(slot) = work.curve.get_mut(vi) {
+        if let Some(slot) = work.curve.get_mut(v) {
             *slot = old_curve;
         }
     }

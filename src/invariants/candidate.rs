@@ -501,7 +501,7 @@ mod tests {
             for t in [0.05, 2.5] {
                 let r = Replacement {
                     new_positions: vec![old + (centre - old) * t],
-                    new_locations: vec![work.locations[vi]],
+                    new_locations: vec![work.locations[v]],
                     new_curve: Vec::new(),
                     triangles: fan
                         .iter()

@@ -42,6 +42,55 @@ fn record_tokens(key: &str, d: usize) -> Option<usize> {
     })
 }
 
+/// What the sections conemesh reads hold, record by record.
+struct Records {
+    positions: Vec<Point3<f64>>,
+    faces: RawFaces,
+    /// Each face's reference number (the record's last token).
+    refs: Vec<i64>,
+}
+
+impl Records {
+    /// One record `rec` of section `key` (lower case), written on line `line`; the records of
+    /// sections conemesh skips are read and dropped.
+    fn take(
+        &mut self,
+        key: &str,
+        rec: &[&str],
+        dim: usize,
+        line: usize,
+        path: &str,
+    ) -> Result<(), IoError> {
+        match key {
+            "vertices" => {
+                let mut p = Point3::origin();
+                for j in 0..dim {
+                    p[j] = float(rec[j], line, path, F)?;
+                }
+                if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+                    return Err(IoError::NonFinite {
+                        path: path.to_string(),
+                        line,
+                        vertex: self.positions.len(),
+                    });
+                }
+                self.positions.push(p);
+            }
+            "triangles" | "quadrilaterals" => {
+                let (corners, reference) = rec.split_at(rec.len() - 1);
+                self.faces.begin(line);
+                for r in corners {
+                    // 1-based in the file.
+                    self.faces.push(int(r, line, path, F)?.saturating_sub(1));
+                }
+                self.refs.push(int(reference[0], line, path, F)?);
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
 pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
     let text = as_text(bytes, path, F)?;
     let mut t = Tokens::new(text);
@@ -80,9 +129,11 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
         None => return Err(trunc(Truncation::InsideHeader { line: l0 })),
     };
     let mut dim = 3;
-    let mut positions: Vec<Point3<f64>> = Vec::new();
-    let mut faces = RawFaces::with_capacity(0, 1);
-    let mut refs: Vec<i64> = Vec::new();
+    let mut records = Records {
+        positions: Vec::new(),
+        faces: RawFaces::with_capacity(0, 1),
+        refs: Vec::new(),
+    };
     let mut warnings = Vec::new();
     while let Some((l, tok)) = t.next() {
         let key = tok.to_ascii_lowercase();
@@ -115,37 +166,17 @@ pub(super) fn read(bytes: &[u8], path: &str) -> Result<LoadedMesh, IoError> {
             for slot in rec.iter_mut().take(k) {
                 *slot = t.next().ok_or_else(|| in_section(tok, t.last_line))?.1;
             }
-            let rl = t.last_line;
-            match key.as_str() {
-                "vertices" => {
-                    let mut p = Point3::origin();
-                    for j in 0..dim {
-                        p[j] = float(rec[j], rl, path, F)?;
-                    }
-                    if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
-                        return Err(IoError::NonFinite {
-                            path: path.to_string(),
-                            line: rl,
-                            vertex: positions.len(),
-                        });
-                    }
-                    positions.push(p);
-                }
-                "triangles" | "quadrilaterals" => {
-                    faces.begin(rl);
-                    for r in &rec[..k - 1] {
-                        // 1-based in the file.
-                        faces.push(int(r, rl, path, F)?.saturating_sub(1));
-                    }
-                    refs.push(int(rec[k - 1], rl, path, F)?);
-                }
-                _ => {} // a skipped section: its record was consumed above
-            }
+            records.take(&key, &rec[..k], dim, t.last_line, path)?;
         }
         if !matches!(key.as_str(), "vertices" | "triangles" | "quadrilaterals") {
             warnings.push(format!("{path}: section `{tok}` skipped"));
         }
     }
+    let Records {
+        positions,
+        faces,
+        refs,
+    } = records;
     let (mesh, polygons, origin, repeated) = build_mesh(path, F, positions, &faces)?;
     if polygons > 0 {
         warnings.push(format!(

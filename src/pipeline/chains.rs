@@ -76,7 +76,7 @@ pub fn patch_domain(
     }
     // The new loop: anchors and untouched vertices as they are, chains' insides replaced.
     let g = |l: VertexId| disk.to_global[l.idx()];
-    let point_of = |l: VertexId| work.curve.get(g(l).idx()).copied().flatten();
+    let point_of = |l: VertexId| work.curve.get(g(l)).copied().flatten();
     let mut loop_vertices: Vec<DomainVertex> = Vec::new();
     let mut loop_uv: Vec<Point2<f64>> = Vec::new();
     let mut loop_pos: Vec<Point3<f64>> = Vec::new();
@@ -200,7 +200,7 @@ fn free_chains(
             && !frozen.is_some_and(|c| c.is_cut_vertex(g(i)))
             && work
                 .curve
-                .get(g(i).idx())
+                .get(g(i))
                 .copied()
                 .flatten()
                 .is_some_and(|p| !curves.is_corner_point(&p))

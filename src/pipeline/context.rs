@@ -35,7 +35,7 @@ pub struct RunContext<'a> {
     pub flip_test: Arc<FlipTest>,
     /// Area-weighted vertex normals of the reference (the fidelity control's; shared with
     /// the regions' contexts).
-    pub ref_normals: Arc<Vec<Vector3<f64>>>,
+    pub ref_normals: Arc<VertexMap<Vector3<f64>>>,
     /// Self-intersecting face pairs of the input (0 when not checked).
     pub input_pairs: usize,
     /// Candidates are checked for local self-intersections: the check is on and the input
@@ -50,7 +50,7 @@ pub struct RunContext<'a> {
     pub input_boundary: Vec<EdgeKey>,
     /// `corners[v]`: input vertex `v` is kept as a corner (its working-mesh id is stable;
     /// new vertices are never corners).
-    pub corners: Vec<bool>,
+    pub corners: VertexMap<bool>,
     /// The input's boundary curves, with their corners.
     pub curves: BoundaryCurves,
     /// Algorithm 2 runs (its patches keep their boundary chains as they are).
@@ -100,8 +100,12 @@ impl<'a> RunContext<'a> {
             false => 0,
         };
         let corners = match o.corner_defect {
-            Some(d) => crate::patches::corner_vertices(reference, &reference_topology, d),
-            None => Vec::new(),
+            Some(d) => VertexMap::from_vec(crate::patches::corner_vertices(
+                reference,
+                &reference_topology,
+                d,
+            )),
+            None => VertexMap::default(),
         };
         let curves = BoundaryCurves::new(
             reference,
@@ -119,7 +123,7 @@ impl<'a> RunContext<'a> {
                 Arc::clone(field.shared_reference()),
                 field.projector(),
             )),
-            ref_normals: Arc::new(reference.area_weighted_normals()),
+            ref_normals: Arc::new(VertexMap::from_vec(reference.area_weighted_normals())),
             input_pairs,
             embedded_input: o.check_self_intersections && input_pairs == 0,
             signature: TopologySignature::of(&reference_topology),
@@ -233,7 +237,7 @@ pub struct LoopState {
     pub improvement: Option<super::records::ImprovementReport>,
     /// `blocked[f]` while a batch is chosen: face `f` shares a vertex with a patch already in
     /// the batch ([`PatchContext::blocked`]); empty between batches.
-    pub blocked: Vec<bool>,
+    pub blocked: FaceMap<bool>,
     /// Where this loop's streams start: 0 for the run on the whole mesh (a batch's patch in
     /// slot `s` draws stream `s + 1`), `(r + 1) · 2³²` for region r's loop
     /// ([`super::regions`]), so no two loops share a stream.
@@ -246,14 +250,14 @@ pub struct LoopState {
     pub regions: Option<(usize, usize)>,
     /// The vertices the improvers may change (the bands around the regions' cuts, after the
     /// regions' runs; past the end: vertices made since, in scope); `None`: all.
-    pub scope: Option<Vec<bool>>,
+    pub scope: Option<VertexMap<bool>>,
     /// Where the working mesh's faces lie, for the candidates' self-intersection certificate
     /// (when the input is embedded); built again before each pass of patches
     /// ([`LoopState::index_faces`]).
     pub near: Option<crate::invariants::NearFaces>,
     /// What holds each vertex of the compacted output in place (set by
     /// [`super::finish::certify_output`]; empty before).
-    pub vertex_kinds: Vec<super::records::VertexKind>,
+    pub vertex_kinds: VertexMap<super::records::VertexKind>,
 }
 
 /// Per-stage times and certificate counts of a run.
@@ -284,14 +288,14 @@ impl LoopState {
         let reference = ctx.quality_field.reference();
         let mut work = WorkingMesh::from_reference(reference);
         for v in reference.vertices() {
-            work.curve[v.idx()] = ctx.curves.point_at_vertex(v);
+            work.curve[v] = ctx.curves.point_at_vertex(v);
         }
         let features = crate::features::split_to_target(
             &mut work,
             reference,
             &ctx.reference_topology,
             &ctx.plan.feature_edges,
-            &ctx.corners,
+            ctx.corners.as_slice(),
             &crate::features::PieceTarget {
                 metrics: ctx.field().vertex_metrics(),
                 l_tar: ctx.plan.l_tar,
@@ -300,9 +304,8 @@ impl LoopState {
             &ctx.flip_test,
         )?;
         let pinned = (0..work.mesh.n_vertices())
-            .map(|v| {
-                ctx.corners.get(v).copied().unwrap_or(false) || features.is_pinned(VertexId::new(v))
-            })
+            .map(VertexId::new)
+            .map(|v| ctx.corners.get(v).copied().unwrap_or(false) || features.is_pinned(v))
             .collect();
         let topo = match features.edges.is_empty() {
             true => (*ctx.reference_topology).clone(),
@@ -356,13 +359,13 @@ impl LoopState {
             records: Vec::new(),
             fallbacks: Fallbacks::default(),
             improvement: None,
-            blocked: Vec::new(),
+            blocked: FaceMap::default(),
             scope: None,
             streams: 0,
             regions: None,
             regions_declined: None,
             near: None,
-            vertex_kinds: Vec::new(),
+            vertex_kinds: VertexMap::default(),
             work,
             topo,
             features,
@@ -470,8 +473,8 @@ impl LoopState {
             topology: &self.topo,
             processed: self.work.processed.as_slice(),
             feature_edges: self.feature_edges(),
-            corners: Some(&ctx.corners),
-            blocked: (!self.blocked.is_empty()).then_some(&self.blocked[..]),
+            corners: Some(ctx.corners.as_slice()),
+            blocked: (!self.blocked.is_empty()).then_some(self.blocked.as_slice()),
         }
     }
 
@@ -481,8 +484,8 @@ impl LoopState {
         self.blocked.resize(self.work.mesh.n_faces(), false);
         for f in faces {
             for v in self.work.mesh.triangles[f.idx()] {
-                for g in self.topo.vertex_faces(v) {
-                    self.blocked[g.idx()] = true;
+                for &g in self.topo.vertex_faces(v) {
+                    self.blocked[g] = true;
                 }
             }
         }

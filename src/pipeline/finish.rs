@@ -8,7 +8,7 @@ use super::records::{
     VertexKind, Warning,
 };
 use super::replace::certify_boundary;
-use crate::ids::{EdgeKey, PatchId, VertexId};
+use crate::ids::{EdgeKey, PatchId, VertexId, VertexMap};
 use crate::invariants::{self, FacePair, InvariantError, Offenders, TopologySignature};
 use crate::mesh::Topology;
 use crate::pipeline::options::CoarseInput;
@@ -20,15 +20,11 @@ use std::time::Instant;
 /// is compacted.
 pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(), PipelineError> {
     certify_whole(ctx, state)?;
-    let kinds = vertex_kinds(ctx, state);
+    let mut kinds = vertex_kinds(ctx, state);
     let map = state.work.compact();
     state.bound.compact(&map, 1.0);
-    state.vertex_kinds = vec![VertexKind::Interior; state.work.mesh.n_vertices()];
-    for (old, new) in map.iter().enumerate() {
-        if let Some(n) = new {
-            state.vertex_kinds[n.idx()] = kinds[old];
-        }
-    }
+    kinds.compact(&map, VertexKind::Interior);
+    state.vertex_kinds = kinds;
     let t0 = Instant::now();
     if ctx.plan.options.check_self_intersections {
         let pairs = invariants::self_intersections(&state.work.mesh);
@@ -54,13 +50,13 @@ pub fn certify_output(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<(),
 /// What holds each working-mesh vertex in place: kept corners (cone points by their input
 /// ids, which the working mesh keeps until [`crate::stitch::WorkingMesh::compact`]; boundary
 /// corners by their curve point), feature-line vertices, boundary vertices.
-fn vertex_kinds(ctx: &RunContext<'_>, state: &LoopState) -> Vec<VertexKind> {
+fn vertex_kinds(ctx: &RunContext<'_>, state: &LoopState) -> VertexMap<VertexKind> {
     (0..state.work.mesh.n_vertices())
         .map(|v| {
             let id = VertexId::new(v);
-            let curve = state.work.curve.get(v).copied().flatten();
+            let curve = state.work.curve.get(id).copied().flatten();
             let curve_corner = curve.is_some_and(|p| ctx.curves.is_corner_point(&p));
-            if ctx.corners.get(v).copied().unwrap_or(false) || curve_corner {
+            if ctx.corners.get(id).copied().unwrap_or(false) || curve_corner {
                 VertexKind::Corner
             } else if state.features.is_pinned(id) {
                 VertexKind::Feature
@@ -112,10 +108,12 @@ pub fn certify_corners(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), Pi
         .iter()
         .flatten()
         .for_each(|v| used[v.idx()] = true);
+    let lost = |v: VertexId| !used[v.idx()] || mesh.positions[v.idx()] != start[v.idx()];
     match (0..ctx.corners.len())
-        .find(|&v| ctx.corners[v] && (!used[v] || mesh.positions[v] != start[v]))
+        .map(VertexId::new)
+        .find(|&v| ctx.corners[v] && lost(v))
     {
-        Some(v) => Err(PipelineError::CornerLost(VertexId::new(v))),
+        Some(v) => Err(PipelineError::CornerLost(v)),
         None => Ok(()),
     }
 }
@@ -241,7 +239,7 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
         &state.work.mesh,
         &out_topo,
     );
-    let small_angles = SmallAngles::of(&state.work.mesh, &metrics, &state.vertex_kinds);
+    let small_angles = SmallAngles::of(&state.work.mesh, &metrics, state.vertex_kinds.as_slice());
     let report = RemeshReport {
         small_angles,
         improvement: state.improvement,
@@ -279,9 +277,9 @@ pub fn into_result(ctx: &RunContext<'_>, state: LoopState) -> RemeshResult {
     };
     RemeshResult {
         mesh: state.work.mesh,
-        locations: state.work.locations,
+        locations: state.work.locations.into_vec(),
         face_patch: state.face_patch.into_vec(),
-        curve: state.work.curve,
+        curve: state.work.curve.into_vec(),
         curves: ctx.curves.clone(),
         report,
         remesh_metric: ctx.field().vertex_metrics().to_vec(),

@@ -49,7 +49,7 @@ impl ImproveRun for Host<'_> {
             pinned: state.pinned.as_slice(),
             curves: Some(&ctx.curves),
             slide_boundary: o.boundary.resample,
-            scope: state.scope.as_deref(),
+            scope: state.scope.as_ref(),
         };
         (surface, &mut state.work)
     }
@@ -177,7 +177,7 @@ fn keeps_the_surface(
         .clone()
         .all(|v| distance(&work.mesh.positions[v.idx()], &new) <= tol)
         && vertices
-            .flat_map(|v| reference.triangles[work.locations[v.idx()].face.idx()])
+            .flat_map(|v| reference.triangles[work.locations[v].face.idx()])
             .all(|r| {
                 let p = reference.positions[r.idx()];
                 let d = distance(&p, &new);
@@ -249,7 +249,7 @@ fn qualities_of_faces(
         .iter()
         .map(|&f| {
             let t = work.mesh.face(f);
-            let m = t.map(|v| ctx.quality_field.eval_at(&work.locations[v.idx()]));
+            let m = t.map(|v| ctx.quality_field.eval_at(&work.locations[v]));
             triangle_quality(work.mesh.face_points(f), &((m[0] + m[1] + m[2]) / 3.0))
         })
         .collect()
@@ -265,7 +265,7 @@ fn qualities_of_candidate(
     let vertex = |v: PatchVertex| match v {
         PatchVertex::Existing(u) => (
             *work.mesh.position(u),
-            ctx.quality_field.eval_at(&work.locations[u.idx()]),
+            ctx.quality_field.eval_at(&work.locations[u]),
         ),
         PatchVertex::New(i) => (
             candidate.new_positions[i as usize],

@@ -209,13 +209,8 @@ const MAX_BATCH_MISSES: usize = 3;
 /// cut short where the batch's earlier patches lie).
 fn clear_of_blocked(state: &LoopState, faces: &[crate::ids::FaceId]) -> bool {
     faces.iter().all(|&f| {
-        !state.blocked[f.idx()]
-            && (0..3).all(|i| {
-                state
-                    .topo
-                    .neighbor(f, i)
-                    .is_none_or(|g| !state.blocked[g.idx()])
-            })
+        !state.blocked[f]
+            && (0..3).all(|i| state.topo.neighbor(f, i).is_none_or(|g| !state.blocked[g]))
     })
 }
 

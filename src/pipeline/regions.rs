@@ -225,11 +225,11 @@ pub fn extract(
             positions: positions.clone(),
             triangles,
         },
-        locations: whole_of.iter().map(|v| whole.locations[v.idx()]).collect(),
+        locations: whole_of.iter().map(|&v| whole.locations[v]).collect(),
         processed: faces.iter().map(|&f| whole.processed[f]).collect(),
         curve: whole_of
             .iter()
-            .map(|v| whole.curve.get(v.idx()).copied().flatten())
+            .map(|&v| whole.curve.get(v).copied().flatten())
             .collect(),
     };
     RegionMesh {
@@ -283,7 +283,7 @@ pub fn run_regions(ctx: &RunContext<'_>, state: &mut LoopState) -> Result<usize,
     }
     // The metric the patches are remeshed in, at every vertex (the weights and the cuts').
     let field = ctx.field();
-    let metrics: Vec<nalgebra::Matrix3<f64>> = (state.work.locations.par_iter())
+    let metrics: Vec<nalgebra::Matrix3<f64>> = (state.work.locations.as_slice().par_iter())
         .map(|l| field.eval_at(l))
         .collect();
     let weights = face_weights(ctx, &state.work, &metrics);
@@ -399,16 +399,16 @@ fn cut_edge_length(
 pub const JUNCTION_RINGS: usize = 8;
 
 /// `flags[v]` for the vertices within `rings` rings of `seeds`.
-fn vertices_near(mesh: &TriMesh, seeds: &[VertexId], rings: usize) -> Vec<bool> {
-    let mut near = vec![false; mesh.n_vertices()];
-    for v in seeds {
-        near[v.idx()] = true;
+fn vertices_near(mesh: &TriMesh, seeds: &[VertexId], rings: usize) -> VertexMap<bool> {
+    let mut near = VertexMap::filled(mesh.n_vertices(), false);
+    for &v in seeds {
+        near[v] = true;
     }
     for _ in 0..rings {
         let mut grown = near.clone();
         for t in &mesh.triangles {
-            if t.iter().any(|v| near[v.idx()]) {
-                t.iter().for_each(|v| grown[v.idx()] = true);
+            if t.iter().any(|&v| near[v]) {
+                t.iter().for_each(|&v| grown[v] = true);
             }
         }
         near = grown;
@@ -421,7 +421,7 @@ fn faces_near(mesh: &TriMesh, seeds: &[VertexId], rings: usize, corners: usize) 
     let near = vertices_near(mesh, seeds, rings);
     mesh.triangles
         .iter()
-        .map(|t| t.iter().filter(|v| near[v.idx()]).count() >= corners)
+        .map(|t| t.iter().filter(|&&v| near[v]).count() >= corners)
         .collect()
 }
 
@@ -601,9 +601,9 @@ fn run_region(
     let topo = Topology::build(&region.work.mesh);
     let cut = Arc::new(region.cut.clone());
     let n = region.whole.len();
-    let from_whole = |flags: &[bool]| -> Vec<bool> {
+    let from_whole = |flags: &VertexMap<bool>| -> VertexMap<bool> {
         (0..n)
-            .map(|l| cut.vertices[l] || flags.get(region.whole[l].idx()).copied().unwrap_or(false))
+            .map(|l| cut.vertices[l] || flags.get(region.whole[l]).copied().unwrap_or(false))
             .collect()
     };
     let corners = from_whole(&ctx.corners);
@@ -625,7 +625,7 @@ fn run_region(
         frozen: Some(cut.clone()),
     };
     let features = region_features(&whole.features, &region);
-    let pinned = VertexMap::from_vec(from_whole(whole.pinned.as_slice()));
+    let pinned = from_whole(&whole.pinned);
     let bound = region.whole.iter().map(|&v| whole.bound[v]).collect();
     let mut state = LoopState::from_parts(region.work.clone(), topo, features, pinned, bound);
     state.budget_share = share;
@@ -700,8 +700,9 @@ fn merge(state: &mut LoopState, region_of: &[u32], runs: Vec<RegionRun>) -> Vec<
         for l in n0..rs.work.mesh.n_vertices() {
             map.push(VertexId::new(w.mesh.n_vertices()));
             w.mesh.positions.push(rs.work.mesh.positions[l]);
-            w.locations.push(rs.work.locations[l]);
-            w.curve.push(rs.work.curve.get(l).copied().flatten());
+            w.locations.push(rs.work.locations[VertexId::new(l)]);
+            w.curve
+                .push(rs.work.curve.get(VertexId::new(l)).copied().flatten());
             state
                 .bound
                 .push(rs.bound.get(VertexId::new(l)).copied().unwrap_or(1.0));
@@ -714,8 +715,8 @@ fn merge(state: &mut LoopState, region_of: &[u32], runs: Vec<RegionRun>) -> Vec<
             // cut vertices are frozen, so this writes them back unchanged): its faces were
             // certified at the new place.
             w.mesh.positions[v.idx()] = rs.work.mesh.positions[l];
-            w.locations[v.idx()] = rs.work.locations[l];
-            w.curve[v.idx()] = rs.work.curve.get(l).copied().flatten();
+            w.locations[v] = rs.work.locations[VertexId::new(l)];
+            w.curve[v] = rs.work.curve.get(VertexId::new(l)).copied().flatten();
             state.factors.raise(v, rs.factors.get(VertexId::new(l)));
             if region.cut.vertices[l] {
                 on_cut.push(v);

@@ -347,7 +347,7 @@ pub fn certify_boundary(ctx: &RunContext<'_>, state: &LoopState) -> Result<(), I
         reference,
         &state.work.mesh,
         &state.topo,
-        &state.work.curve,
+        state.work.curve.as_slice(),
     )?;
     if ctx.plan.options.boundary.resample {
         return Ok(());
@@ -396,15 +396,13 @@ fn certify_region_boundary(
         .iter()
         .filter(|e| !cut.is_cut_edge(e.0, e.1))
         .flat_map(|e| [e.0, e.1])
-        .filter(
-            |&v| match state.work.curve.get(v.idx()).copied().flatten() {
-                Some(p) => {
-                    p.curve as usize >= ctx.curves.len()
-                        || ctx.curves.position(reference, &p) != mesh.positions[v.idx()]
-                }
-                None => true,
-            },
-        )
+        .filter(|&v| match state.work.curve.get(v).copied().flatten() {
+            Some(p) => {
+                p.curve as usize >= ctx.curves.len()
+                    || ctx.curves.position(reference, &p) != mesh.positions[v.idx()]
+            }
+            None => true,
+        })
         .collect();
     off.sort_unstable();
     off.dedup();

@@ -226,7 +226,9 @@ fn certify_patch(
         debug_file: write_debug(&ctx.plan.options, pid, "patch", &state.work.mesh, faces),
     })?;
     counters.cert.disk += 1;
-    if let Some(vertex) = interior_corner(&state.work.mesh, &state.topo, faces, &ctx.corners) {
+    if let Some(vertex) =
+        interior_corner(&state.work.mesh, &state.topo, faces, ctx.corners.as_slice())
+    {
         return Err(PipelineError::CornerInterior {
             patch: pid,
             seed,
@@ -493,7 +495,7 @@ fn remesh_and_lift(
     let setup = RoundsSetup {
         options: &fidelity,
         field,
-        normals: &ctx.ref_normals,
+        normals: ctx.ref_normals.as_slice(),
         l_tar: ctx.plan.l_tar,
         min_edge: ctx.plan.min_edge,
     };

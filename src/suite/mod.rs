@@ -80,8 +80,8 @@ pub enum SuiteError {
     NoMatch {
         /// the filter
         filter: String,
-        /// every case name, comma-separated
-        known: String,
+        /// every case name
+        known: crate::registry::Names,
     },
     /// The surface generator refused its parameters.
     #[error("case {case}: {source}")]
@@ -320,7 +320,7 @@ pub fn select<'a>(cases: &'a [Case], filters: &[String]) -> Result<Vec<&'a Case>
     {
         return Err(SuiteError::NoMatch {
             filter: f.clone(),
-            known: cases.iter().map(|c| c.name).collect::<Vec<_>>().join(", "),
+            known: crate::registry::Names(cases.iter().map(|c| c.name).collect()),
         });
     }
     Ok(cases

@@ -12,19 +12,6 @@ use std::path::PathBuf;
 /// The shared meshes directory beside the crate (the default of [`dir`]).
 pub const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes");
 
-/// How large a mesh is, so a test can pick cheap ones or skip expensive ones.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Size {
-    /// At most 1,000 faces (decimated-knight).
-    Tiny,
-    /// Under 10,000 faces.
-    Small,
-    /// 10,000 to 20,000 faces.
-    Medium,
-    /// More (the two Stanford scans).
-    Large,
-}
-
 /// One shared mesh: its file and what `../shared/meshes/README.md` says about it.
 #[derive(Clone, Copy, Debug)]
 pub struct SharedMesh {
@@ -90,16 +77,6 @@ impl SharedMesh {
         self.file
             .rsplit_once('.')
             .map_or(self.file, |(stem, _)| stem)
-    }
-
-    /// The size class, from the face count.
-    pub fn size(&self) -> Size {
-        match self.faces {
-            0..=1_000 => Size::Tiny,
-            1_001..=9_999 => Size::Small,
-            10_000..=20_000 => Size::Medium,
-            _ => Size::Large,
-        }
     }
 
     /// The file's path; panics with a clear message when the shared directory is missing.
