@@ -17,8 +17,8 @@
 //! resampled. Every replaced patch is certified as in Algorithm 1.
 //! Termination: within a pass every patch marks at least one unprocessed face processed
 //! (Algorithm 1's argument); a further pass runs only when the previous one strictly lowered
-//! the count of faces below the threshold, and there are at most `passes` of them. Each pass
-//! takes one ring more around the bad faces than the last.
+//! the count of faces below the threshold or raised the mesh's smallest angle, and there are
+//! at most `passes` of them. Each pass takes one ring more around the bad faces than the last.
 
 use super::{Eq5Options, Eq5Updates, ImproveRun, Improver, ImproverCounts};
 use super::{LoopStages, RunError};
@@ -36,7 +36,7 @@ pub struct ImproveOptions {
     /// stretched, at several times the cost).
     pub angle_threshold: f64,
     /// Passes over the faces below the threshold (default 3); a pass runs only while the
-    /// previous one strictly lowered their count.
+    /// previous one strictly lowered their count or raised the smallest angle.
     pub passes: usize,
     /// Rings of faces around a bad face that its patch takes in the first pass, one more in
     /// each further pass (default 2).
@@ -164,7 +164,13 @@ impl Improver for Algorithm2 {
             };
             counts.passes += 1;
             let budget = o.max_patches.map(|m| m.saturating_sub(counts.patches));
-            let pass = run.patch_pass(pass_stages, &bad, budget, &|old, new| better_at_the_bottom(o.bottom, old, new), rng)?;
+            let pass = run.patch_pass(
+                pass_stages,
+                &bad,
+                budget,
+                &|old, new| better_at_the_bottom(o.bottom, old, new),
+                rng,
+            )?;
             counts.patches += pass.patches;
             counts.rejected += pass.rejected;
             if pass.budget_exhausted {
@@ -299,5 +305,41 @@ mod tests {
             &[t(10.0, 0.3), t(19.0, 0.5), t(60.0, 1.0)]
         ));
         assert!(!better_at_the_bottom(Bottom::QualityAndAngles, &old, &[]));
+    }
+
+    #[test]
+    fn a_further_pass_runs_after_one_that_lowered_the_count_or_raised_the_smallest_angle() {
+        let p = |bad, theta_min| Progress { bad, theta_min };
+        let before = p(10, 12.0);
+        assert!(p(9, 12.0).beats(&before));
+        assert!(
+            p(10, 12.5).beats(&before),
+            "the worst face opened, as many left"
+        );
+        assert!(
+            p(11, 12.5).beats(&before),
+            "one face traded for several, all better"
+        );
+        assert!(
+            !p(10, 12.0).beats(&before),
+            "nothing gained: the passes stop"
+        );
+        assert!(!p(12, 11.0).beats(&before));
+    }
+
+    #[test]
+    fn with_the_angles_bottom_a_candidate_may_lower_q_min_to_open_the_smallest_angle() {
+        let t = |a: f64, q: f64| TriangleQuality {
+            q,
+            angles: [a, 0.5 * (180.0 - a), 0.5 * (180.0 - a)],
+        };
+        let old = [t(10.0, 0.3), t(40.0, 0.9)];
+        // The sliver opened to 20°, the other face made obtuse below the old q_min.
+        let new = [t(20.0, 0.5), t(25.0, 0.25)];
+        assert!(!better_at_the_bottom(Bottom::QualityAndAngles, &old, &new));
+        assert!(better_at_the_bottom(Bottom::Angles, &old, &new));
+        // Neither takes a candidate that lowers the smallest angle.
+        let lower = [t(9.0, 0.9), t(60.0, 1.0)];
+        assert!(!better_at_the_bottom(Bottom::Angles, &old, &lower));
     }
 }

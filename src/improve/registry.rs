@@ -52,7 +52,7 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
             },
             OptionDoc {
                 name: "passes",
-                doc: "passes over the faces below q, each only if the last lowered their count",
+                doc: "passes over the faces below q, each only if the last lowered their count or raised θ_min",
                 default: |_| ImproveOptions::default().passes.to_string(),
             },
             OptionDoc {
@@ -229,6 +229,7 @@ mod tests {
             "w=inf",
             "flips=best",
             "target=big",
+            "bottom=q",
         ] {
             let option = bad.split('=').next().unwrap_or_default().to_string();
             assert!(
