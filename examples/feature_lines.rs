@@ -1,6 +1,7 @@
 //! The feature lines `--feature-angle auto` picks on a mesh, one chain per line: edges, length
 //! (fraction of the bounding-box diagonal), smallest and mean dihedral angle, largest turn
-//! between consecutive edges. Diagnostics for the automatic rule (issue 20).
+//! between consecutive edges, whether it is closed, and how many of its ends are free (no other
+//! feature edge there, not on the boundary). Diagnostics for the automatic rule (issue 20).
 //! `cargo run --release --example feature_lines -- MESH [RULE]`
 
 use conemesh::features::{feature_chains, FeatureRule};
@@ -41,6 +42,12 @@ fn main() {
         }
     }
     let diag = mesh.bbox_diagonal();
+    // Feature edges at each vertex: a chain's end where only its own edge meets is free.
+    let mut degree: HashMap<conemesh::ids::VertexId, usize> = HashMap::new();
+    for e in &sharp {
+        *degree.entry(e.0).or_default() += 1;
+        *degree.entry(e.1).or_default() += 1;
+    }
     let chains = feature_chains(&mesh, &topo, &sharp, &[]);
     println!(
         "{path}: {} feature edges in {} chains",
@@ -58,13 +65,17 @@ fn main() {
             .map(|k| (p(k) - p(k - 1)).angle(&(p(k + 1) - p(k))).to_degrees())
             .fold(0.0, f64::max);
         println!(
-            "edges {:4} length {:.4} dihedral min {:5.1} mean {:5.1} turn max {:5.1} closed {}",
+            "edges {:4} length {:.4} dihedral min {:5.1} mean {:5.1} turn max {:5.1} closed {} free ends {}",
             c.len() - 1,
             len / diag,
             angles.iter().copied().fold(f64::INFINITY, f64::min),
             angles.iter().sum::<f64>() / angles.len() as f64,
             turn,
-            c.first() == c.last()
+            c.first() == c.last(),
+            [c[0], c[c.len() - 1]]
+                .iter()
+                .filter(|v| degree.get(v) == Some(&1) && !topo.is_boundary_vertex(**v))
+                .count()
         );
     }
 }
