@@ -151,9 +151,14 @@ fn relocate(
     try_candidates(ctx, topo, work, state, v, &candidates, &[])
 }
 
+/// A boundary vertex sliding between its neighbours also tries `SLIDE_SWEEP − 1` evenly spaced
+/// places of the span ([`slide`]).
+const SLIDE_SWEEP: usize = 8;
+
 /// Try to slide the boundary vertex `v` along its input curve, between its boundary
 /// neighbours `prev` and `next`: to where its two boundary edges have equal metric length,
-/// and half way there. Corners never slide.
+/// half way there, and `SLIDE_SWEEP − 1` evenly spaced places between the neighbours, best
+/// fan first. Corners never slide.
 fn slide(
     ctx: &SurfaceContext<'_>,
     topo: &Topology,
@@ -204,8 +209,12 @@ fn slide(
     }
     let f_now = da / span;
     let f_bal = 0.5 * (lo + hi);
+    // Also a sweep of the span: beside a kept corner whose one face is an ear, the best place
+    // is where the ear is isoceles, far from the balance point.
+    let sweep = (1..SLIDE_SWEEP).map(|k| k as f64 / SLIDE_SWEEP as f64);
     let candidates: Vec<Candidate> = [f_bal, 0.5 * (f_now + f_bal)]
         .into_iter()
+        .chain(sweep)
         .filter(|f| *f > 0.0 && *f < 1.0)
         .map(|f| {
             let cp = at(f);
