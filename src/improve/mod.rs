@@ -186,6 +186,12 @@ pub struct SurfaceContext<'a> {
     /// How far a change may move the surface (unit space); `f64::INFINITY` when the distance
     /// control is off.
     pub tol: f64,
+    /// The run's target length L_tar in [`SurfaceContext::field`]'s metric (NaN: unknown, then
+    /// a boundary vertex sweeps its span only where its fan holds a bad face).
+    pub l_tar: f64,
+    /// A sliding boundary vertex also tries evenly spaced places between its neighbours, not
+    /// only the balance point and half way there.
+    pub slide_sweep: bool,
     /// Edges no flip may remove (feature lines).
     pub feature_edges: Option<&'a HashSet<EdgeKey>>,
     /// `pinned[v]`: vertex `v` may not move (corners and feature-line vertices).
@@ -218,6 +224,9 @@ pub struct SurfacePasses {
     pub flips: bool,
     /// Run the vertex position update, then flips again (default `true`).
     pub relocate: bool,
+    /// A sliding boundary vertex also sweeps its span for a better place, not only the
+    /// balance point (default `true`; [`SurfaceContext::slide_sweep`]).
+    pub sweep: bool,
 }
 
 impl Default for SurfacePasses {
@@ -225,6 +234,7 @@ impl Default for SurfacePasses {
         SurfacePasses {
             flips: true,
             relocate: true,
+            sweep: true,
         }
     }
 }
@@ -240,7 +250,8 @@ impl Improver for SurfacePasses {
         run: &mut dyn ImproveRun,
         _rng: &mut crate::Rng,
     ) -> Result<ImproverCounts, RunError> {
-        let (ctx, work) = run.surface();
+        let (mut ctx, work) = run.surface();
+        ctx.slide_sweep = self.sweep;
         let passes = finishing_passes(&ctx, work, self.flips, self.relocate);
         Ok(ImproverCounts {
             flips: passes.flips,

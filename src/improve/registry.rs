@@ -33,6 +33,11 @@ pub static IMPROVERS: &[Entry<dyn Improver>] = &[
                 doc: "the vertex position update, then flips again",
                 default: |_| SurfacePasses::default().relocate.to_string(),
             },
+            OptionDoc {
+                name: "sweep",
+                doc: "a sliding boundary vertex also tries 7 evenly spaced places between its neighbours",
+                default: |_| SurfacePasses::default().sweep.to_string(),
+            },
         ],
         build: surface,
     },
@@ -145,6 +150,9 @@ fn surface(p: &mut Params, _: MetricSizes) -> Result<Box<dyn Improver>, BadValue
     }
     if let Some(b) = p.take("relocate", "true or false")? {
         s.relocate = b;
+    }
+    if let Some(b) = p.take("sweep", "true or false")? {
+        s.sweep = b;
     }
     Ok(Box::new(s))
 }

@@ -155,10 +155,19 @@ fn relocate(
 /// places of the span ([`slide`]).
 const SLIDE_SWEEP: usize = 8;
 
+/// The fan quality under which [`slide`] sweeps the span whatever the pieces' lengths
+/// (Algorithm 2's default threshold).
+const SLIDE_SWEEP_BELOW_Q: f64 = 0.5;
+
+/// The lengths (× L_tar, in the metric) both boundary pieces keep at a place of the sweep
+/// where no face of the fan is bad: the boundary's resampling range (issue 17's 0.7–1.4).
+const SLIDE_SWEEP_PIECES: (f64, f64) = (0.7, 1.4);
+
 /// Try to slide the boundary vertex `v` along its input curve, between its boundary
 /// neighbours `prev` and `next`: to where its two boundary edges have equal metric length,
-/// half way there, and `SLIDE_SWEEP − 1` evenly spaced places between the neighbours, best
-/// fan first. Corners never slide.
+/// half way there, and `SLIDE_SWEEP − 1` evenly spaced places between the neighbours (where
+/// both pieces stay on target, or anywhere when its fan holds a bad face); best fan first.
+/// Corners never slide.
 fn slide(
     ctx: &SurfaceContext<'_>,
     topo: &Topology,
@@ -210,11 +219,24 @@ fn slide(
     let f_now = da / span;
     let f_bal = 0.5 * (lo + hi);
     // Also a sweep of the span: beside a kept corner whose one face is an ear, the best place
-    // is where the ear is isoceles, far from the balance point.
-    let sweep = (1..SLIDE_SWEEP).map(|k| k as f64 / SLIDE_SWEEP as f64);
+    // is where the ear is isoceles, far from the balance point. A place of the sweep keeps
+    // both boundary pieces within [`SLIDE_SWEEP_PIECES`] L_tar, so that the boundary stays
+    // resampled to the metric, unless a face of the fan is bad.
+    let bad = fan_quality(&work.mesh, &state.metrics, topo.vertex_faces(v)) < SLIDE_SWEEP_BELOW_Q;
+    let (lo_piece, hi_piece) = SLIDE_SWEEP_PIECES;
+    let on_target = |f: f64| {
+        let x = curves.position(reference, &at(f));
+        [len(&xa, &x), len(&x, &xb)]
+            .iter()
+            .all(|l| (lo_piece * ctx.l_tar..=hi_piece * ctx.l_tar).contains(l))
+    };
+    let sweep: Vec<f64> = (1..SLIDE_SWEEP)
+        .map(|k| k as f64 / SLIDE_SWEEP as f64)
+        .filter(|&f| ctx.slide_sweep && (bad || on_target(f)))
+        .collect();
     let candidates: Vec<Candidate> = [f_bal, 0.5 * (f_now + f_bal)]
         .into_iter()
-        .chain(sweep)
+        .chain(sweep.iter().copied())
         .filter(|f| *f > 0.0 && *f < 1.0)
         .map(|f| {
             let cp = at(f);

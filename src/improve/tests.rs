@@ -16,6 +16,8 @@ fn ctx<'a>(
         flip_test,
         embedded_input: true,
         tol,
+        l_tar: f64::NAN,
+        slide_sweep: false,
         feature_edges,
         pinned: &[],
         curves: None,

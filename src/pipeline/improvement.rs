@@ -45,6 +45,8 @@ impl ImproveRun for Host<'_> {
             flip_test: &ctx.flip_test,
             embedded_input: ctx.embedded_input,
             tol: passes_tolerance(ctx.plan.eps),
+            l_tar: ctx.plan.l_tar,
+            slide_sweep: true,
             feature_edges: (!state.features.edges.is_empty()).then_some(&state.features.edges),
             pinned: state.pinned.as_slice(),
             curves: Some(&ctx.curves),
