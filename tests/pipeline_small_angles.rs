@@ -177,7 +177,6 @@ fn the_boundary_sweep_opens_the_smallest_angles_and_keeps_the_boundary_on_target
             .as_ref()
             .expect("the improvers ran")
             .after
-            .clone()
     };
     let (a, b) = (after(&without), after(&with));
     assert!(
