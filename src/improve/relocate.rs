@@ -218,35 +218,38 @@ fn slide(
     }
     let f_now = da / span;
     let f_bal = 0.5 * (lo + hi);
+    let candidate = |f: f64| {
+        let cp = at(f);
+        Candidate {
+            position: curves.position(reference, &cp),
+            location: curves.location(&cp),
+            curve: Some(cp),
+        }
+    };
+    let mut candidates: Vec<Candidate> = [f_bal, 0.5 * (f_now + f_bal)]
+        .into_iter()
+        .filter(|f| *f > 0.0 && *f < 1.0)
+        .map(candidate)
+        .collect();
     // Also a sweep of the span: beside a kept corner whose one face is an ear, the best place
     // is where the ear is isoceles, far from the balance point. A place of the sweep keeps
     // both boundary pieces within [`SLIDE_SWEEP_PIECES`] L_tar, so that the boundary stays
     // resampled to the metric, unless a face of the fan is bad.
-    let bad = fan_quality(&work.mesh, &state.metrics, topo.vertex_faces(v)) < SLIDE_SWEEP_BELOW_Q;
-    let (lo_piece, hi_piece) = SLIDE_SWEEP_PIECES;
-    let on_target = |f: f64| {
-        let x = curves.position(reference, &at(f));
-        [len(&xa, &x), len(&x, &xb)]
-            .iter()
-            .all(|l| (lo_piece * ctx.l_tar..=hi_piece * ctx.l_tar).contains(l))
-    };
-    let sweep: Vec<f64> = (1..SLIDE_SWEEP)
-        .map(|k| k as f64 / SLIDE_SWEEP as f64)
-        .filter(|&f| ctx.slide_sweep && (bad || on_target(f)))
-        .collect();
-    let candidates: Vec<Candidate> = [f_bal, 0.5 * (f_now + f_bal)]
-        .into_iter()
-        .chain(sweep.iter().copied())
-        .filter(|f| *f > 0.0 && *f < 1.0)
-        .map(|f| {
-            let cp = at(f);
-            Candidate {
-                position: curves.position(reference, &cp),
-                location: curves.location(&cp),
-                curve: Some(cp),
-            }
-        })
-        .collect();
+    if ctx.slide_sweep {
+        let bad =
+            fan_quality(&work.mesh, &state.metrics, topo.vertex_faces(v)) < SLIDE_SWEEP_BELOW_Q;
+        let (lo_piece, hi_piece) = SLIDE_SWEEP_PIECES;
+        let on_target = |x: &Point3<f64>| {
+            [len(&xa, x), len(x, &xb)]
+                .iter()
+                .all(|l| (lo_piece * ctx.l_tar..=hi_piece * ctx.l_tar).contains(l))
+        };
+        candidates.extend(
+            (1..SLIDE_SWEEP)
+                .map(|k| candidate(k as f64 / SLIDE_SWEEP as f64))
+                .filter(|c| bad || on_target(&c.position)),
+        );
+    }
     // The input curve's vertices between the neighbours: the new chords must not pass
     // farther from them than the tolerance.
     let between: Vec<Point3<f64>> = curves
